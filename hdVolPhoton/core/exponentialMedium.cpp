@@ -1,0 +1,83 @@
+#include "core/exponentialMedium.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace volphoton {
+namespace {
+// exp() of anything above this overflows double; densities beyond e^MaxExponent are clamped.
+constexpr double MaxExponent = 700.0;
+
+/// (1 - e^{-x}) / x, exact as x -> 0 (the naive form cancels catastrophically below x ~ 1e-8).
+double oneMinusExpOverX(double x) {
+    if (x == 0) return 1.0;
+    return -std::expm1(-x) / x;
+}
+}  // namespace
+
+double exponentialOpticalDepth(double a, double b, double h0, double mu, double s) {
+    // tau = int_0^s a e^{-b (h0 + mu t)} dt = a e^{-b h0} s (1 - e^{-b mu s}) / (b mu s)
+    double start = a * std::exp(std::min(-b * h0, MaxExponent));
+    double x = b * mu * s;
+    if (x < -MaxExponent) return Infinity;  // the path dives far below h0: opaque
+    return start * s * oneMinusExpOverX(x);
+}
+
+ExponentialMedium::ExponentialMedium(const MediumCoefficients& c, double a, double b, const Vec3& origin,
+                                     const Vec3& up, const Bounds3& bounds)
+    : c_(c), a_(a), b_(b), origin_(origin), bounds_(bounds) {
+    if (!(a >= 0) || !std::isfinite(a)) throw std::invalid_argument("exponential medium: a must be finite and >= 0");
+    if (!(b >= 0) || !std::isfinite(b)) throw std::invalid_argument("exponential medium: b must be finite and >= 0");
+    if (!isFinite(up) || length(up) == 0) throw std::invalid_argument("exponential medium: up must be a non-zero vector");
+    if (!isFinite(origin)) throw std::invalid_argument("exponential medium: origin must be finite");
+    if (!c.phase) throw std::invalid_argument("exponential medium: missing phase function");
+    up_ = normalize(up);
+    sigmaMaxChannel_ = c_.sigma_t().maxValue();
+}
+
+double ExponentialMedium::relativeDensity(const Vec3& p) const {
+    double h = dot(p - origin_, up_);
+    return a_ * std::exp(std::min(-b_ * h, MaxExponent));
+}
+
+MediumProperties ExponentialMedium::properties(const Vec3& p) const {
+    MediumProperties mp;
+    if (!bounds_.contains(p)) return mp;
+    double d = relativeDensity(p);
+    mp.sigma_a = c_.sigma_a * d;
+    mp.emission = c_.emission * d;
+    mp.addLobe(c_.phase.get(), c_.sigma_s * d);
+    return mp;
+}
+
+// The majorant handed to the free-flight routine is the exact channel-max extinction
+// sigma_max a e^{-b h(t)} = sigmaMaj e^{-b mu (t - t0)}: a decaying segment. For grey media it equals
+// sigma_t, so every tentative collision is real and free flights are sampled in closed form by
+// inverting tau (see freeFlight.h); chromatic media see null collisions only in the thinner channels.
+void ExponentialMedium::majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const {
+    double t0, t1;
+    if (sigmaMaxChannel_ == 0 || a_ == 0 || !bounds_.intersect(ray, tMin, tMax, &t0, &t1)) return;
+    double start = sigmaMaxChannel_ * relativeDensity(ray.at(t0));
+    segment(MajorantSegment{t0, t1, start, b_ * dot(ray.d, up_)});
+}
+
+std::optional<Spectrum> ExponentialMedium::opticalDepth(const Ray& ray, double t0, double t1) const {
+    double a, b;
+    if (!bounds_.intersect(ray, t0, t1, &a, &b)) return Spectrum(0.0);
+    double h0 = dot(ray.at(a) - origin_, up_);
+    double tau = exponentialOpticalDepth(a_, b_, h0, dot(ray.d, up_), b - a);
+    Spectrum st = c_.sigma_t();
+    Spectrum r;
+    for (int i = 0; i < 3; ++i) r[i] = st[i] == 0 ? 0.0 : st[i] * tau;
+    return r;
+}
+
+double ExponentialMedium::maxAlbedo() const { return c_.maxAlbedo(); }
+
+std::string ExponentialMedium::describe() const {
+    std::ostringstream s;
+    s << "exponential(a=" << a_ << " b=" << b_ << " phase=" << c_.phase->describe() << ")";
+    return s.str();
+}
+
+}  // namespace volphoton

@@ -1,0 +1,65 @@
+// The one free-flight routine. Every estimator (camera paths, shadow rays, photons, transmittance)
+// samples distances through sampleFreeFlight(); none walks majorants on its own (pbrt-v4's SampleT_maj
+// shape, with a scalar majorant).
+//
+// Within a majorant segment the majorant is sigma(t) = sigma0 e^{-k (t - t0)}, whose optical depth
+// from t0 is tau(s) = sigma0 s (1 - e^{-k s})/(k s). Tentative collisions are drawn by inverting it:
+//   s = -log(1 - tau k / sigma0) / k  = (tau / sigma0) * L(tau k / sigma0),  L(x) = -log1p(-x)/x,
+// which is exact for k = 0 (L = 1) and has no solution when tau k / sigma0 >= 1: the ray never
+// accumulates tau before t -> infinity (it leaves a decaying atmosphere), so the segment is passed.
+//
+// The majorant is scalar: it bounds sigma_t in every channel. Chromatic media are then unbiased
+// without averaging: callers weight by per-channel ratios (sigma_n,c / sigma_maj for ratio tracking;
+// spectral tracking, Kutz et al. 2017, for scattering paths).
+#pragma once
+
+#include "core/medium.h"
+#include "core/rng.h"
+
+namespace volphoton {
+
+/// A tentative collision: position, local coefficients and the majorant that produced it.
+struct MediumEvent {
+    double t;
+    Vec3 p;
+    MediumProperties mp;
+    double sigmaMaj;
+};
+
+/// Distance s at which the majorant's optical depth from the current point reaches tau, or infinity
+/// when it never does. sigma is the majorant at the current point, decay its exponential rate.
+inline double invertMajorantDepth(double tau, double sigma, double decay) {
+    if (!(sigma > 0)) return Infinity;
+    double s = tau / sigma;
+    if (decay == 0) return s;
+    double x = s * decay;
+    if (x >= 1) return Infinity;
+    return x == 0 ? s : s * (-std::log1p(-x) / x);
+}
+
+/// Draws tentative collisions along ray over (0, tMax) through `medium`'s majorants, calling
+/// callback(const MediumEvent&) -> bool at each, in increasing t. The callback returns false to stop
+/// (a real scattering or absorption). Returns true when the ray reached tMax without being stopped.
+template <typename Callback>
+bool sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback) {
+    bool reachedEnd = true;
+    medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
+        double t = seg.tMin;
+        double sigma = seg.sigmaMaj;
+        while (true) {
+            double tau = -std::log1p(-rng.uniform());  // Exp(1); uniform() < 1 keeps it finite
+            double dt = invertMajorantDepth(tau, sigma, seg.decay);
+            if (!(dt < seg.tMax - t)) return true;  // passed the segment: on to the next one
+            t += dt;
+            if (seg.decay != 0) sigma = std::min(seg.sigmaMaj * std::exp(-seg.decay * (t - seg.tMin)), 1e300);
+            MediumEvent event{t, ray.at(t), medium.properties(ray.at(t)), sigma};
+            if (!callback(event)) {
+                reachedEnd = false;
+                return false;
+            }
+        }
+    });
+    return reachedEnd;
+}
+
+}  // namespace volphoton

@@ -1,0 +1,203 @@
+#include <tbb/blocked_range2d.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+#include "core/diagnostics.h"
+#include "core/integratorBase.h"
+
+namespace volphoton {
+
+double fresnelDielectric(double cosI, double eta) {
+    cosI = std::clamp(cosI, 0.0, 1.0);
+    double sin2T = (1 - cosI * cosI) / (eta * eta);
+    if (sin2T >= 1) return 1.0;  // total internal reflection
+    double cosT = std::sqrt(1 - sin2T);
+    double rs = (cosI - eta * cosT) / (cosI + eta * cosT);
+    double rp = (eta * cosI - cosT) / (eta * cosI + cosT);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+Integrator::Integrator(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
+    transmittance_.cutoff = settings.transmittanceCutoff;
+    std::vector<double> power;
+    for (const LightPtr& l : scene.lights()) power.push_back(l->power(scene.radius()).average());
+    if (!power.empty()) lightDist_ = Distribution1D(power);
+    cameraStack_ = scene.stackAt(Camera(scene.desc().camera, 1, 1).position());
+}
+
+DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng) const {
+    DirectSample d;
+    if (!lightDist_.size()) return d;
+    size_t i = lightDist_.sampleDiscrete(rng.uniform(), &d.pickProb);
+    double u1 = rng.uniform(), u2 = rng.uniform();
+    d.light = static_cast<int>(i);
+    d.ls = scene_.lights()[i]->sample(p, u1, u2);
+    return d;
+}
+
+bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light) const {
+    bool found = false;
+    for (size_t i = 0; i < scene_.lights().size(); ++i) {
+        double th;
+        Spectrum L;
+        double p;
+        if (scene_.lights()[i]->intersect(ray, tMax, &th, &L, &p) && (!found || th < *t)) {
+            found = true;
+            *t = th;
+            *Le = L;
+            *pdf = p;
+            *light = static_cast<int>(i);
+            if (!std::isinf(th)) tMax = th;
+        }
+    }
+    return found;
+}
+
+Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng) const {
+    Spectrum T(1.0);
+    Ray ray{p, w};
+    double travelled = 0;
+    for (int crossings = 0; crossings < 64; ++crossings) {
+        SurfaceHit hit;
+        double remaining = dist - travelled;
+        bool blocked = scene_.intersect(ray, 0.0, remaining * (1 - 1e-7) - scene_.epsilon(), &hit);
+        double segment = blocked ? hit.t : remaining;
+        if (scene_.hasMedia()) {
+            MediumAggregate media = scene_.mediaFor(stack);
+            if (media.size()) T *= transmittance(media, ray, std::isinf(segment) ? 1e30 : segment, rng, transmittance_);
+            if (T.isBlack()) return T;
+        }
+        if (!blocked) return T;
+        if (scene_.mesh(hit.mesh).material.kind != SurfaceMaterial::Kind::Boundary) return Spectrum(0.0);
+        stack.toggle(hit.mesh);
+        Vec3 o = offset(hit, w);
+        travelled += length(o - ray.o);
+        ray.o = o;
+    }
+    return Spectrum(0.0);
+}
+
+SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng,
+                                          bool radianceMode) const {
+    SurfaceScatter s;
+    const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+    Vec3 wo = -ray.d;
+    switch (m.kind) {
+        case SurfaceMaterial::Kind::Boundary:
+            stack.toggle(hit.mesh);
+            s.type = SurfaceScatter::Type::Pass;
+            s.next = {offset(hit, ray.d), ray.d};
+            s.crossed = true;
+            return s;
+        case SurfaceMaterial::Kind::Lambertian: {
+            if (m.albedo.isBlack()) return s;
+            Vec3 n = dot(wo, hit.ns) >= 0 ? hit.ns : -hit.ns;
+            Vec3 w = Frame::fromZ(n).toWorld(cosineHemisphere(rng.uniform(), rng.uniform()));
+            if (dot(w, hit.ng) * dot(wo, hit.ng) <= 0) return s;  // shading normal sent it below the surface
+            s.type = SurfaceScatter::Type::Diffuse;
+            s.next = {offset(hit, w), w};
+            s.weight = m.albedo;  // f cos / pdf = (albedo/pi) cos / (cos/pi)
+            return s;
+        }
+        case SurfaceMaterial::Kind::Dielectric: {
+            bool inside = stack.contains(hit.mesh);
+            double eta = inside ? 1.0 / m.ior : m.ior;  // n_t / n_i along the path
+            Vec3 n = dot(wo, hit.ng) >= 0 ? hit.ng : -hit.ng;
+            double cosI = dot(wo, n);
+            double F = fresnelDielectric(cosI, eta);
+            if (rng.uniform() < F) {
+                Vec3 r = n * (2 * cosI) - wo;
+                s.type = SurfaceScatter::Type::Specular;
+                s.next = {offset(hit, r), r};
+                return s;
+            }
+            double sin2T = (1 - cosI * cosI) / (eta * eta);
+            double cosT = std::sqrt(std::max(0.0, 1 - sin2T));
+            Vec3 t = normalize(-wo / eta + n * (cosI / eta - cosT));
+            s.type = SurfaceScatter::Type::Specular;
+            s.next = {offset(hit, t), t};
+            s.crossed = true;
+            if (radianceMode) s.weight = Spectrum(1.0 / (eta * eta));
+            stack.toggle(hit.mesh);
+            return s;
+        }
+    }
+    return s;
+}
+
+Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings)
+    : scene_(std::move(scene)), settings_(settings), film_(settings.width, settings.height) {
+    if (settings_.samplesPerPixel < 0) throw std::invalid_argument("render settings: samplesPerPixel must be >= 0");
+    if (settings_.maxDepth < 0) throw std::invalid_argument("render settings: maxDepth must be >= 0");
+    if (settings_.photonsPerPass < 0) throw std::invalid_argument("render settings: photonsPerPass must be >= 0");
+    if (!(settings_.radiusAlpha > 0 && settings_.radiusAlpha <= 1)) throw std::invalid_argument("render settings: radiusAlpha must be in (0, 1]");
+    integrator_ = settings_.integrator == RenderSettings::Integrator::PhotonMap ? makePhotonMapper(*scene_, settings_)
+                                                                               : makePathTracer(*scene_, settings_);
+    if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
+    if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
+}
+
+Renderer::~Renderer() = default;
+
+bool Renderer::renderPass(const CancelCallback& cancel) {
+    auto start = std::chrono::steady_clock::now();
+    std::unique_ptr<tbb::global_control> threads;
+    if (settings_.threads > 0)
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings_.threads);
+    if (!integrator_->beginPass(pass_, stats_, cancel)) {
+        stats_.cancelled = true;
+        return false;
+    }
+    auto photonsDone = std::chrono::steady_clock::now();
+    Camera camera(scene_->desc().camera, settings_.width, settings_.height);
+    std::atomic<bool> cancelled{false};
+    const int tile = 16;
+    int tilesX = (settings_.width + tile - 1) / tile, tilesY = (settings_.height + tile - 1) / tile;
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, tilesY, 0, tilesX), [&](const tbb::blocked_range2d<int>& r) {
+        for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
+            for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
+                if (cancelled.load(std::memory_order_relaxed) || (cancel && cancel())) {
+                    cancelled = true;
+                    return;
+                }
+                for (int y = ty * tile; y < std::min(settings_.height, (ty + 1) * tile); ++y)
+                    for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
+                        Rng rng(hashKeys(x, y, settings_.seed), static_cast<uint64_t>(pass_));
+                        double tMin, tMax;
+                        Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
+                        PathRadiance L = integrator_->Li(ray, tMin, tMax, rng);
+                        // Never let a numerical accident reach the film: report and drop the sample.
+                        if (!L.beauty().isFinite() || L.beauty().minValue() < 0) {
+                            static std::atomic<int> reported{0};
+                            if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
+                            L = PathRadiance();
+                        }
+                        film_.add(x, y, L);
+                    }
+            }
+    });
+    auto end = std::chrono::steady_clock::now();
+    stats_.photonSeconds += std::chrono::duration<double>(photonsDone - start).count();
+    stats_.cameraSeconds += std::chrono::duration<double>(end - photonsDone).count();
+    stats_.seconds += std::chrono::duration<double>(end - start).count();
+    if (cancelled) {
+        stats_.cancelled = true;
+        return false;
+    }
+    stats_.cameraSamples += static_cast<uint64_t>(settings_.width) * settings_.height;
+    ++pass_;
+    ++stats_.passes;
+    return true;
+}
+
+RenderStats Renderer::render(const ProgressCallback& progress, const CancelCallback& cancel) {
+    for (int i = 0; i < settings_.samplesPerPixel; ++i) {
+        if (!renderPass(cancel)) break;
+        if (progress) progress(i + 1, settings_.samplesPerPixel);
+    }
+    return stats_;
+}
+
+}  // namespace volphoton

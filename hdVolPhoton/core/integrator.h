@@ -1,0 +1,112 @@
+// Render settings, statistics and the progressive renderer shared by both integrators.
+//
+// Render settings (the Hydra delegate exposes the same names as render-setting descriptors):
+// | name                | type   | default    | units        | meaning                                          |
+// |---------------------|--------|------------|--------------|--------------------------------------------------|
+// | integrator          | enum   | pathTracer |              | pathTracer (unbiased) or photonMap                |
+// | width, height       | int    | 640, 360   | pixels       | image size                                        |
+// | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass      |
+// | maxDepth            | int    | 64         |              | scattering/bounce events per path                 |
+// | rouletteDepth       | int    | 3          |              | events before Russian roulette may end a path     |
+// | seed                | uint64 | 0          |              | every random stream hashes (pixel, pass, seed)    |
+// | threads             | int    | 0          |              | 0: all cores                                      |
+// | photonsPerPass      | int    | 100000     |              | photonMap: photons traced per pass               |
+// | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
+// |                     |        |            |              | the scene diameter)                               |
+// | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
+// | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
+// |                     |        |            |              | the scene diameter)                               |
+// | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |
+// | multipleScattering  | bool   | true       |              | photonMap: run the photon (multiple) pass         |
+// | multipleThreshold   | double | 1e-3       |              | photonMap: skip photons when a pilot estimates the|
+// |                     |        |            |              | multiple/single energy ratio below this           |
+// | transmittanceCutoff | double | 0          |              | deterministic early termination (BIASED)          |
+//
+// AOVs: the light-path split is decided by the first vertex of the camera path other than an
+// index-matched medium boundary:
+//  - emission: volume emission reached along the first segment;
+//  - single:   light from a light source scattered once at a first vertex in a medium;
+//  - multiple: everything else that first scatters in a medium (light scattered twice or more,
+//              scattered volume emission, light scattered in the medium after a surface bounce);
+//  - surface:  everything whose first vertex is a surface (lambertian or dielectric), plus lights and
+//              the environment seen directly through the media.
+// beauty = single + multiple + emission + surface, in both integrators.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/film.h"
+#include "core/scene.h"
+#include "core/transmittance.h"
+
+namespace volphoton {
+
+struct RenderSettings {
+    enum class Integrator { PathTracer, PhotonMap };
+    Integrator integrator = Integrator::PathTracer;
+    int width = 640, height = 360;
+    int samplesPerPixel = 16;
+    int maxDepth = 64;
+    int rouletteDepth = 3;
+    uint64_t seed = 0;
+    int threads = 0;
+    int photonsPerPass = 100000;
+    double initialRadius = 0;
+    double radiusAlpha = 0.7;
+    double marchStep = 0;
+    bool singleScattering = true;
+    bool multipleScattering = true;
+    double multipleThreshold = 1e-3;
+    double transmittanceCutoff = 0;
+};
+
+/// What ran, what was skipped and why, and how long each part took.
+struct RenderStats {
+    int passes = 0;
+    uint64_t cameraSamples = 0;
+    uint64_t photonsTraced = 0;
+    uint64_t photonsStored = 0;
+    double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
+    double photonRadius = 0;
+    double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
+    size_t photonMapBytes = 0;
+    std::vector<std::string> passesRun;
+    std::vector<std::string> passesSkipped;  ///< "name: reason"
+    bool cancelled = false;
+};
+
+using ProgressCallback = std::function<void(int passDone, int passTotal)>;
+using CancelCallback = std::function<bool()>;
+
+class Integrator;
+
+/// \class Renderer
+/// Progressive rendering of a Scene into a Film: each pass adds one sample per pixel (after a photon
+/// pass for the photon-map integrator). Tiles run in parallel with TBB; the cancel callback is polled
+/// per tile and per photon batch. Same settings -> bit-identical film.
+class Renderer {
+public:
+    Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings);
+    ~Renderer();
+    /// Runs one more pass; returns false if cancelled.
+    bool renderPass(const CancelCallback& cancel = {});
+    /// Runs all samplesPerPixel passes.
+    RenderStats render(const ProgressCallback& progress = {}, const CancelCallback& cancel = {});
+    const Film& film() const { return film_; }
+    const RenderStats& stats() const { return stats_; }
+    const RenderSettings& settings() const { return settings_; }
+
+private:
+    std::shared_ptr<const Scene> scene_;
+    RenderSettings settings_;
+    Film film_;
+    RenderStats stats_;
+    std::unique_ptr<Integrator> integrator_;
+    int pass_ = 0;
+};
+
+}  // namespace volphoton

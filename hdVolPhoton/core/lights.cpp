@@ -1,0 +1,384 @@
+#include "core/lights.h"
+
+#include <ImfArray.h>
+#include <ImfRgbaFile.h>
+
+#include <sstream>
+#include <stdexcept>
+
+#include "core/diagnostics.h"
+#include "core/sampling.h"
+
+namespace volphoton {
+
+double spotFalloff(double cosAngle, double coneAngle, double coneSoftness) {
+    double angle = std::acos(std::clamp(cosAngle, -1.0, 1.0));
+    if (coneAngle >= Pi) return 1.0;
+    double inner = coneAngle * (1 - std::clamp(coneSoftness, 0.0, 1.0));
+    if (angle <= inner) return 1.0;
+    if (angle >= coneAngle) return 0.0;
+    double x = (coneAngle - angle) / (coneAngle - inner);
+    return x * x * (3 - 2 * x);
+}
+
+namespace {
+
+void requireFinite(const Spectrum& s, const char* what) {
+    if (!s.isFinite() || s.minValue() < 0) throw std::invalid_argument(std::string(what) + ": emission must be finite and >= 0");
+}
+
+/// Photon origin on a disc of radius r perpendicular to `dir`, upstream of the scene's bounding sphere.
+Vec3 upstreamDiscPoint(const Vec3& center, double radius, const Vec3& dir, double u1, double u2) {
+    double x, y;
+    concentricDisk(u1, u2, &x, &y);
+    Frame f = Frame::fromZ(dir);
+    return center - dir * radius + f.s * (x * radius) + f.t * (y * radius);
+}
+
+class DistantLight final : public Light {
+public:
+    DistantLight(const Vec3& dir, double halfAngle, const Spectrum& E) : dir_(normalize(dir)), E_(E) {
+        requireFinite(E, "distant light");
+        if (!isFinite(dir) || length(dir) == 0) throw std::invalid_argument("distant light: direction must be non-zero");
+        halfAngle = std::clamp(halfAngle, 0.0, Pi / 2);
+        cosMax_ = std::cos(halfAngle);
+        // Uniform cone of radiance L at normal incidence gives E = L pi sin^2(halfAngle).
+        double sin2 = 1 - cosMax_ * cosMax_;
+        delta_ = sin2 < 1e-12;
+        L_ = delta_ ? E : E / (Pi * sin2);
+    }
+    LightSample sample(const Vec3&, double u1, double u2) const override {
+        LightSample s;
+        if (delta_) {
+            s.wi = -dir_;
+            s.Li = E_;
+            s.pdf = 1;
+            s.isDelta = true;
+        } else {
+            s.wi = Frame::fromZ(-dir_).toWorld(uniformCone(u1, u2, cosMax_));
+            s.Li = L_;
+            s.pdf = uniformConePdf(cosMax_);
+        }
+        return s;
+    }
+    bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const override {
+        if (delta_ || !std::isinf(tMax) || dot(ray.d, -dir_) < cosMax_) return false;
+        *t = Infinity;
+        *Le = L_;
+        *pdf = uniformConePdf(cosMax_);
+        return true;
+    }
+    bool isDelta() const override { return delta_; }
+    Spectrum power(double r) const override { return E_ * (Pi * r * r); }
+    PhotonEmission emitPhoton(const Vec3& c, double r, double u[4]) const override {
+        Vec3 d = delta_ ? dir_ : Frame::fromZ(dir_).toWorld(uniformCone(u[2], u[3], cosMax_));
+        return {{upstreamDiscPoint(c, r, d, u[0], u[1]), d}, E_ * (Pi * r * r)};
+    }
+    std::string describe() const override { return "distant"; }
+
+private:
+    Vec3 dir_;
+    Spectrum E_, L_;
+    double cosMax_;
+    bool delta_;
+};
+
+class SphereLight final : public Light {
+public:
+    SphereLight(const Vec3& p, double radius, const Spectrum& L, const Vec3& axis, double coneAngle, double softness)
+        : p_(p), r_(std::max(0.0, radius)), L_(L), axis_(axis), cone_(coneAngle), softness_(softness) {
+        requireFinite(L, "sphere light");
+        if (!isFinite(p) || !std::isfinite(radius)) throw std::invalid_argument("sphere light: position and radius must be finite");
+        shaped_ = coneAngle < Pi;
+        if (shaped_) axis_ = normalize(axis);
+    }
+    double shaping(const Vec3& emitDir) const { return shaped_ ? spotFalloff(dot(emitDir, axis_), cone_, softness_) : 1.0; }
+    LightSample sample(const Vec3& ref, double u1, double u2) const override {
+        LightSample s;
+        Vec3 toCenter = p_ - ref;
+        double d2 = lengthSquared(toCenter), d = std::sqrt(d2);
+        if (d == 0) return s;
+        if (r_ == 0 || d <= r_) {  // point light (or reference inside the sphere: treat as a point)
+            s.wi = toCenter / d;
+            s.dist = d;
+            s.Li = L_ * (shaping(-s.wi) / d2);
+            if (r_ > 0) s.Li *= Pi * r_ * r_;  // radiance L of a sphere seen from far: I = L pi r^2
+            s.pdf = 1;
+            s.isDelta = true;
+            return s;
+        }
+        // Uniform sampling of the cone the sphere subtends (pbrt-v4 Sphere::Sample(ctx)).
+        double sinMax2 = r_ * r_ / d2, cosMax = std::sqrt(std::max(0.0, 1 - sinMax2));
+        Vec3 w = Frame::fromZ(toCenter / d).toWorld(uniformCone(u1, u2, cosMax));
+        double tHit;
+        if (!hitSphere({ref, w}, &tHit)) tHit = std::sqrt(std::max(0.0, d2 - r_ * r_));
+        s.wi = w;
+        s.dist = tHit;
+        s.Li = L_ * shaping(-w);
+        s.pdf = uniformConePdf(cosMax);
+        return s;
+    }
+    bool hitSphere(const Ray& ray, double* t) const {
+        Vec3 oc = ray.o - p_;
+        double b = dot(oc, ray.d), c = lengthSquared(oc) - r_ * r_;
+        double disc = b * b - c;
+        if (disc < 0) return false;
+        double sq = std::sqrt(disc);
+        double t0 = -b - sq, t1 = -b + sq;
+        *t = t0 > 1e-9 * (1 + std::abs(b)) ? t0 : t1;
+        return *t > 0;
+    }
+    bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const override {
+        if (r_ == 0 || !hitSphere(ray, t) || *t >= tMax) return false;
+        double d2 = lengthSquared(p_ - ray.o);
+        if (d2 <= r_ * r_) return false;
+        double cosMax = std::sqrt(std::max(0.0, 1 - r_ * r_ / d2));
+        *Le = L_ * shaping(ray.d);
+        *pdf = uniformConePdf(cosMax);
+        return true;
+    }
+    bool isDelta() const override { return r_ == 0; }
+    Spectrum power(double) const override {
+        // Point: 4 pi I; sphere: pi L * 4 pi r^2. Spot shaping scales by the cone's solid-angle share,
+        // approximated by its hard cone (used for light selection and photon budgets only).
+        double share = shaped_ ? (1 - std::cos(cone_)) / 2 : 1.0;
+        return (r_ == 0 ? L_ * (4 * Pi) : L_ * (Pi * 4 * Pi * r_ * r_)) * share;
+    }
+    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+        PhotonEmission e;
+        if (r_ == 0) {
+            Vec3 d = uniformSphere(u[0], u[1]);
+            e.ray = {p_, d};
+            e.flux = L_ * (shaping(d) / UniformSpherePdf);
+        } else {
+            Vec3 n = uniformSphere(u[0], u[1]);
+            Vec3 d = Frame::fromZ(n).toWorld(cosineHemisphere(u[2], u[3]));
+            e.ray = {p_ + n * (r_ * (1 + 1e-9)), d};
+            e.flux = L_ * (shaping(d) * Pi * 4 * Pi * r_ * r_);
+        }
+        return e;
+    }
+    std::string describe() const override { return r_ == 0 ? "point" : "sphere"; }
+
+private:
+    Vec3 p_;
+    double r_;
+    Spectrum L_;
+    Vec3 axis_;
+    double cone_, softness_;
+    bool shaped_ = false;
+};
+
+/// Rect and disk: planar one-sided emitters facing local -Z.
+class PlanarLight final : public Light {
+public:
+    PlanarLight(const Affine& toWorld, bool disk, double sx, double sy, const Spectrum& L) : disk_(disk), L_(L) {
+        requireFinite(L, disk ? "disk light" : "rect light");
+        if (!(sx > 0) || !(sy > 0)) throw std::invalid_argument(std::string(disk ? "disk" : "rect") + " light: size must be positive");
+        center_ = toWorld.point(Vec3());
+        ex_ = toWorld.vector(Vec3(disk ? sx : sx / 2, 0, 0));
+        ey_ = toWorld.vector(Vec3(0, disk ? sx : sy / 2, 0));
+        Vec3 c = cross(ex_, ey_);
+        area_ = length(c) * (disk ? Pi : 4.0);
+        if (!(area_ > 0) || !std::isfinite(area_)) throw std::invalid_argument("planar light: degenerate transform");
+        // UsdLux: rect and disk lights emit along local -Z; the geometric normal keeps that side under
+        // shear and non-uniform scale.
+        Vec3 geometric = normalize(cross(ey_, ex_));
+        n_ = dot(geometric, toWorld.vector(Vec3(0, 0, -1))) >= 0 ? geometric : -geometric;
+    }
+    Vec3 pointAt(double u1, double u2) const {
+        if (disk_) {
+            double x, y;
+            concentricDisk(u1, u2, &x, &y);
+            return center_ + ex_ * x + ey_ * y;
+        }
+        return center_ + ex_ * (2 * u1 - 1) + ey_ * (2 * u2 - 1);
+    }
+    LightSample sample(const Vec3& ref, double u1, double u2) const override {
+        LightSample s;
+        Vec3 p = pointAt(u1, u2), d = p - ref;
+        double dist2 = lengthSquared(d), dist = std::sqrt(dist2);
+        if (dist == 0) return s;
+        s.wi = d / dist;
+        double cosL = -dot(s.wi, n_);
+        if (cosL <= 0) return s;
+        s.dist = dist;
+        s.Li = L_;
+        s.pdf = dist2 / (cosL * area_);
+        return s;
+    }
+    bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const override {
+        double denom = dot(ray.d, n_);
+        if (denom >= 0) return false;  // back side or parallel
+        double th = dot(center_ - ray.o, n_) / denom;
+        if (!(th > 0) || th >= tMax) return false;
+        Vec3 q = ray.at(th) - center_;
+        // Coordinates in the (ex, ey) frame; ex and ey may be non-orthogonal under shear.
+        double exx = dot(ex_, ex_), eyy = dot(ey_, ey_), exy = dot(ex_, ey_);
+        double qx = dot(q, ex_), qy = dot(q, ey_), det = exx * eyy - exy * exy;
+        double a = (qx * eyy - qy * exy) / det, b = (qy * exx - qx * exy) / det;
+        if (disk_ ? a * a + b * b > 1 : (std::abs(a) > 1 || std::abs(b) > 1)) return false;
+        *t = th;
+        *Le = L_;
+        *pdf = th * th / (-denom * area_);
+        return true;
+    }
+    bool isDelta() const override { return false; }
+    Spectrum power(double) const override { return L_ * (Pi * area_); }
+    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+        Vec3 d = Frame::fromZ(n_).toWorld(cosineHemisphere(u[2], u[3]));
+        return {{pointAt(u[0], u[1]) + n_ * 1e-9 * (1 + length(center_)), d}, L_ * (Pi * area_)};
+    }
+    std::string describe() const override { return disk_ ? "disk" : "rect"; }
+
+private:
+    bool disk_;
+    Spectrum L_;
+    Vec3 center_, ex_, ey_, n_;
+    double area_;
+};
+
+class DomeLight final : public Light {
+public:
+    DomeLight(const Spectrum& L, LatLongImage img, const Affine& toWorld) : L_(L), img_(std::move(img)), toWorld_(toWorld) {
+        requireFinite(L, "dome light");
+        auto inv = toWorld.inverse();
+        if (!inv) throw std::invalid_argument("dome light: transform is not invertible");
+        toLight_ = *inv;
+        if (img_.width > 0) {
+            // Importance ~ luminance * sin(theta) (the lat-long map's solid-angle Jacobian).
+            std::vector<double> f(static_cast<size_t>(img_.width) * img_.height);
+            for (int y = 0; y < img_.height; ++y) {
+                double sinTheta = std::sin(Pi * (y + 0.5) / img_.height);
+                for (int x = 0; x < img_.width; ++x) f[y * img_.width + x] = luminance(texel(x, y)) * sinTheta + 1e-12;
+            }
+            dist_ = Distribution2D(f, img_.width, img_.height);
+            for (int y = 0; y < img_.height; ++y)
+                for (int x = 0; x < img_.width; ++x) {
+                    Spectrum t = texel(x, y);
+                    if (!t.isFinite() || t.minValue() < 0) throw std::invalid_argument("dome light: texture has NaN, Inf or negative texels");
+                    double sinTheta = std::sin(Pi * (y + 0.5) / img_.height);
+                    integral_ += t * (sinTheta * (2 * Pi / img_.width) * (Pi / img_.height));
+                }
+        } else {
+            integral_ = Spectrum(4 * Pi);
+        }
+    }
+    Spectrum texel(int x, int y) const {
+        size_t i = 3 * (static_cast<size_t>(y) * img_.width + x);
+        return {img_.rgb[i], img_.rgb[i + 1], img_.rgb[i + 2]};
+    }
+    // Lat-long convention: light-space +Y up; u = 0.5 + atan2(x, -z)/(2 pi), v = acos(y)/pi.
+    Spectrum radiance(const Vec3& worldDir, double* pdf) const {
+        if (img_.width == 0) {
+            *pdf = UniformSpherePdf;
+            return L_;
+        }
+        Vec3 d = normalize(toLight_.vector(worldDir));
+        double u = 0.5 + std::atan2(d.x, -d.z) / (2 * Pi), v = std::acos(std::clamp(d.y, -1.0, 1.0)) / Pi;
+        int x = std::clamp(static_cast<int>(u * img_.width), 0, img_.width - 1);
+        int y = std::clamp(static_cast<int>(v * img_.height), 0, img_.height - 1);
+        double sinTheta = std::sqrt(std::max(0.0, 1 - d.y * d.y));
+        *pdf = sinTheta > 0 ? dist_.pdf(u, v) / (2 * Pi * Pi * sinTheta) : 0.0;
+        return L_ * texel(x, y);
+    }
+    Vec3 sampleDirection(double u1, double u2, double* pdf) const {
+        if (img_.width == 0) {
+            *pdf = UniformSpherePdf;
+            return uniformSphere(u1, u2);
+        }
+        double u, v, mapPdf;
+        dist_.sample(u1, u2, &u, &v, &mapPdf);
+        double theta = v * Pi, phi = (u - 0.5) * 2 * Pi;
+        double sinTheta = std::sin(theta);
+        Vec3 d(sinTheta * std::sin(phi), std::cos(theta), -sinTheta * std::cos(phi));
+        *pdf = sinTheta > 0 ? mapPdf / (2 * Pi * Pi * sinTheta) : 0.0;
+        return normalize(toWorld_.vector(d));
+    }
+    LightSample sample(const Vec3&, double u1, double u2) const override {
+        LightSample s;
+        s.wi = sampleDirection(u1, u2, &s.pdf);
+        double pdf;
+        s.Li = radiance(s.wi, &pdf);
+        return s;
+    }
+    bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const override {
+        if (!std::isinf(tMax)) return false;
+        *t = Infinity;
+        *Le = radiance(ray.d, pdf);
+        return true;
+    }
+    bool isDelta() const override { return false; }
+    Spectrum power(double r) const override { return L_ * integral_ * (Pi * r * r); }
+    PhotonEmission emitPhoton(const Vec3& c, double r, double u[4]) const override {
+        double pdf;
+        Vec3 toLight = sampleDirection(u[2], u[3], &pdf);
+        double pdfDummy;
+        Spectrum L = radiance(toLight, &pdfDummy);
+        Vec3 d = -toLight;
+        return {{upstreamDiscPoint(c, r, d, u[0], u[1]), d}, pdf > 0 ? L * (Pi * r * r / pdf) : Spectrum(0.0)};
+    }
+    std::string describe() const override { return img_.width ? "dome(texture)" : "dome"; }
+
+private:
+    Spectrum L_;
+    LatLongImage img_;
+    Affine toWorld_, toLight_;
+    Distribution2D dist_;
+    Spectrum integral_;
+};
+
+}  // namespace
+
+LatLongImage loadLatLongExr(const std::string& path) {
+    try {
+        Imf::RgbaInputFile file(path.c_str());
+        Imath::Box2i dw = file.dataWindow();
+        int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+        if (w <= 0 || h <= 0 || static_cast<long>(w) * h > (1L << 28)) throw std::runtime_error("bad image size");
+        Imf::Array2D<Imf::Rgba> px(h, w);
+        file.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * w, 1, w);
+        file.readPixels(dw.min.y, dw.max.y);
+        LatLongImage img;
+        img.width = w;
+        img.height = h;
+        img.rgb.resize(static_cast<size_t>(w) * h * 3);
+        size_t bad = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                float c[3] = {px[y][x].r, px[y][x].g, px[y][x].b};
+                for (int k = 0; k < 3; ++k) {
+                    if (!std::isfinite(c[k]) || c[k] < 0) { c[k] = 0; ++bad; }
+                    img.rgb[3 * (static_cast<size_t>(y) * w + x) + k] = c[k];
+                }
+            }
+        if (bad) {
+            std::ostringstream msg;
+            msg << "dome texture '" << path << "': " << bad << " NaN, Inf or negative values clamped to 0";
+            warn(msg.str());
+        }
+        return img;
+    } catch (const std::exception& e) {
+        throw std::runtime_error("cannot read environment texture '" + path + "': " + e.what());
+    }
+}
+
+LightPtr makeDistantLight(const Vec3& direction, double halfAngle, const Spectrum& E) {
+    return std::make_shared<DistantLight>(direction, halfAngle, E);
+}
+LightPtr makeSphereLight(const Vec3& p, double radius, const Spectrum& L) {
+    return std::make_shared<SphereLight>(p, radius, L, Vec3(0, 0, -1), Pi, 0.0);
+}
+LightPtr makeSpotLight(const Vec3& p, double radius, const Spectrum& L, const Vec3& axis, double coneAngle, double softness) {
+    if (!(coneAngle > 0)) throw std::invalid_argument("spot light: cone angle must be positive");
+    return std::make_shared<SphereLight>(p, radius, L, axis, coneAngle, softness);
+}
+LightPtr makeRectLight(const Affine& m, double w, double h, const Spectrum& L) {
+    return std::make_shared<PlanarLight>(m, false, w, h, L);
+}
+LightPtr makeDiskLight(const Affine& m, double r, const Spectrum& L) { return std::make_shared<PlanarLight>(m, true, r, r, L); }
+LightPtr makeDomeLight(const Spectrum& L, LatLongImage image, const Affine& m) {
+    return std::make_shared<DomeLight>(L, std::move(image), m);
+}
+
+}  // namespace volphoton

@@ -1,0 +1,78 @@
+// Light sources. Quantities are physical (the USD front ends convert UsdLux intensity, exposure,
+// colour and normalize into them):
+//
+// | kind     | parameters                                   | emitted quantity                          |
+// |----------|----------------------------------------------|-------------------------------------------|
+// | distant  | direction (propagation), halfAngle (rad)     | irradiance E (W/m^2) normal to direction  |
+// | sphere   | position, radius (0: point light)            | radiance L; intensity I (W/sr) if point   |
+// |          | spot: axis, coneAngle (rad), coneSoftness    | spot falloff, see spotFalloff()           |
+// | rect     | lightToWorld, width, height                  | radiance L, emitted towards local -Z      |
+// | disk     | lightToWorld, radius                         | radiance L, emitted towards local -Z      |
+// | dome     | constant radiance or lat-long RGB texture    | radiance L(direction)                     |
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace volphoton {
+
+/// Light sampled from a reference point: direction towards the light, distance to it, radiance
+/// arriving (intensity / d^2 for point lights) and solid-angle density (1 for delta lights).
+struct LightSample {
+    Vec3 wi;
+    double dist = Infinity;
+    Spectrum Li;
+    double pdf = 0;
+    bool isDelta = false;
+};
+
+/// A photon leaving a light: origin, propagation direction and flux weight (power / pdf).
+struct PhotonEmission {
+    Ray ray;
+    Spectrum flux;
+};
+
+/// \class Light
+/// Immutable; all methods thread-safe.
+class Light {
+public:
+    virtual ~Light() = default;
+    virtual LightSample sample(const Vec3& ref, double u1, double u2) const = 0;
+    /// Ray-hit query for lights with area or extent (escaping rays for distant and dome lights):
+    /// radiance seen along the ray if it hits the light before tMax, the hit distance and the
+    /// solid-angle density sample() would have produced the direction with.
+    virtual bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const = 0;
+    virtual bool isDelta() const = 0;
+    /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
+    virtual Spectrum power(double sceneRadius) const = 0;
+    virtual PhotonEmission emitPhoton(const Vec3& sceneCenter, double sceneRadius, double u[4]) const = 0;
+    virtual std::string describe() const = 0;
+};
+
+using LightPtr = std::shared_ptr<const Light>;
+
+struct LatLongImage {
+    int width = 0, height = 0;
+    std::vector<float> rgb;  ///< linear RGB, row-major, top row = +Y (up)
+};
+
+/// Reads a lat-long environment from an OpenEXR file; throws std::runtime_error naming the file.
+LatLongImage loadLatLongExr(const std::string& path);
+
+LightPtr makeDistantLight(const Vec3& direction, double halfAngle, const Spectrum& irradiance);
+LightPtr makeSphereLight(const Vec3& position, double radius, const Spectrum& radianceOrIntensity);
+/// Spot: a sphere/point light with its emission shaped by a cone around `axis`.
+LightPtr makeSpotLight(const Vec3& position, double radius, const Spectrum& radianceOrIntensity, const Vec3& axis,
+                       double coneAngle, double coneSoftness);
+LightPtr makeRectLight(const Affine& lightToWorld, double width, double height, const Spectrum& radiance);
+LightPtr makeDiskLight(const Affine& lightToWorld, double radius, const Spectrum& radiance);
+/// Dome: constant radiance, or radiance * texture when the image is non-empty. worldToLight orients it.
+LightPtr makeDomeLight(const Spectrum& radiance, LatLongImage image = {}, const Affine& lightToWorld = {});
+
+/// UsdLux ShapingAPI cone falloff: 1 inside coneAngle*(1-softness), smoothstep to 0 at coneAngle.
+double spotFalloff(double cosAngle, double coneAngle, double coneSoftness);
+
+}  // namespace volphoton

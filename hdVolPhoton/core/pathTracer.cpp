@@ -1,0 +1,192 @@
+// Integrator 1: the unbiased volumetric path tracer (the reference).
+//
+// Free flights come from sampleFreeFlight() with a scalar majorant; the event at each tentative
+// collision is chosen by spectral tracking with history-aware probabilities (Kutz, Habel, Li and
+// Novak 2017, "Spectral and Decomposition Tracking for Rendering Heterogeneous Volumes", sec. 5):
+//   P_a ~ avg(sigma_a beta), P_s ~ avg(sigma_s beta), P_n ~ avg(sigma_n beta), sigma_n = sigma_maj - sigma_t
+// and the throughput beta is multiplied by sigma_x / (sigma_maj P_x), which keeps every RGB channel
+// unbiased in chromatic media without averaging. Volume emission is collected at every tentative
+// collision as beta * emission / sigma_maj (pbrt-v4's VolPathIntegrator does the same).
+// Direct light: next-event estimation with shadow transmittance (closed form where the media have one,
+// else ratio tracking), combined with phase/BSDF sampling by MIS (power heuristic) for lights with
+// extent; delta lights by light sampling alone.
+#include "core/freeFlight.h"
+#include "core/integratorBase.h"
+
+namespace volphoton {
+namespace {
+
+enum class Branch { Undecided, Medium, Surface };
+
+class PathTracer final : public Integrator {
+public:
+    using Integrator::Integrator;
+
+    PathRadiance Li(const Ray& cameraRay, double tMin, double tMax, Rng& rng) const override {
+        PathRadiance out;
+        Ray ray = cameraRay;
+        Spectrum beta(1.0);
+        MediumStack stack = cameraStack_;
+        Branch branch = Branch::Undecided;
+        bool specular = true;  // the previous vertex cannot be light-sampled (camera, mirror, refraction)
+        double prevPdf = 0;
+        int depth = 0, crossings = 0;
+        bool firstSegment = true;
+        bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
+
+        auto add = [&](const Spectrum& L, bool singleCandidate) {
+            if (branch == Branch::Undecided) out.surface += L;  // lights/environment seen directly
+            else if (branch == Branch::Surface) out.surface += L;
+            else if (singleCandidate) out.single += L;
+            else out.multiple += L;
+        };
+
+        while (true) {
+            SurfaceHit hit;
+            bool hasHit = scene_.intersect(ray, tMin, tMax, &hit);
+            double tEnd = hasHit ? hit.t : tMax;
+            double tLight;
+            Spectrum lightLe;
+            double lightPdf = 0;
+            int light = -1;
+            bool hasLight = hitLight(ray, tEnd, &tLight, &lightLe, &lightPdf, &light);
+            if (hasLight && !std::isinf(tLight)) tEnd = tLight;
+            if (firstSegment && hasHit) out.depth = hit.t;
+
+            // Medium interaction along [tMin, tEnd].
+            bool scattered = false, absorbed = false;
+            MediumEvent scatter{};
+            if (scene_.hasMedia()) {
+                MediumAggregate media = scene_.mediaFor(stack);
+                if (media.size()) {
+                    bool emissive = media.isEmissive();
+                    Ray local{ray.at(tMin), ray.d};
+                    double length = std::isinf(tEnd) ? 1e30 : tEnd - tMin;
+                    sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
+                        if (emissive && !e.mp.emission.isBlack()) {
+                            Spectrum L = beta * e.mp.emission / e.sigmaMaj;
+                            if (branch == Branch::Undecided) out.emission += L;
+                            else add(L, false);
+                        }
+                        Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
+                        for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
+                        double pa = (e.mp.sigma_a * beta).average(), ps = (e.mp.sigma_s * beta).average();
+                        double pn = (sigma_n * beta).average(), total = pa + ps + pn;
+                        if (!(total > 0)) { absorbed = true; return false; }
+                        double u = rng.uniform() * total;
+                        if (u < pa) { absorbed = true; return false; }
+                        if (u < pa + ps) {
+                            beta *= total / (e.sigmaMaj * ps);  // sigma_s goes into the phase kernel below
+                            scatter = e;
+                            scatter.t += tMin;
+                            scattered = true;
+                            return false;
+                        }
+                        beta *= sigma_n * (total / (e.sigmaMaj * pn));
+                        return true;
+                    });
+                }
+            }
+            if (absorbed) break;
+            if (scattered) {
+                if (firstSegment) out.alpha = 1;
+                if (++depth > settings_.maxDepth) break;
+                bool firstVertex = branch == Branch::Undecided;
+                if (firstVertex) branch = Branch::Medium;
+                const MediumProperties& mp = scatter.mp;
+                Vec3 p = scatter.p;
+                // Next-event estimation.
+                DirectSample ds = sampleDirect(p, rng);
+                if (ds.light >= 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack()) {
+                    double cosTheta = dot(ray.d, ds.ls.wi);
+                    Spectrum f = mp.scatterKernel(cosTheta);
+                    if (!f.isBlack()) {
+                        Spectrum T = shadowTransmittance(p, ds.ls.wi, ds.ls.dist, stack, rng);
+                        double lightDensity = ds.pickProb * ds.ls.pdf;
+                        double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, mp.scatterPdf(cosTheta));
+                        add(beta * f * T * ds.ls.Li * (w / lightDensity), firstVertex);
+                    }
+                }
+                // Phase sampling.
+                Vec3 w = mp.sampleScatter(ray.d, rng.uniform(), rng.uniform(), rng.uniform());
+                double cosTheta = dot(ray.d, w);
+                double pdf = mp.scatterPdf(cosTheta);
+                if (!(pdf > 0)) break;
+                beta *= mp.scatterKernel(cosTheta) / pdf;
+                prevPdf = pdf;
+                specular = false;
+                ray = {p, w};
+                tMin = 0;
+                tMax = Infinity;
+                firstSegment = false;
+                lightHitIsSingle = firstVertex;
+                if (!roulette(beta, depth, rng)) break;
+                continue;
+            }
+            bool lightWasSingle = lightHitIsSingle;
+            lightHitIsSingle = false;
+            // Reached a light, a surface, or escaped.
+            if (hasLight && (!hasHit || tLight <= hit.t)) {
+                double w = specular ? 1.0 : powerHeuristic(prevPdf, lightPickProb(light) * lightPdf);
+                add(beta * lightLe * w, lightWasSingle);
+                if (firstSegment && !std::isinf(tLight)) out.alpha = 1;
+                break;
+            }
+            if (!hasHit) break;
+            if (firstSegment) out.alpha = 1;
+            const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+            if (m.kind == SurfaceMaterial::Kind::Boundary) {
+                if (++crossings > 256) break;
+                SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
+                ray = s.next;
+                tMin = 0;
+                tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
+                continue;
+            }
+            if (branch == Branch::Undecided) branch = Branch::Surface;
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
+                add(beta * m.emission, false);  // emissive meshes are found by hits only (no light sampling)
+            if (++depth > settings_.maxDepth) break;
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack()) {
+                DirectSample ds = sampleDirect(hit.p, rng);
+                Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
+                double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
+                if (cosL > 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack() && dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) > 0) {
+                    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
+                    double lightDensity = ds.pickProb * ds.ls.pdf;
+                    double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, cosL * InvPi);
+                    add(beta * m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity), false);
+                }
+            }
+            SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
+            if (s.type == SurfaceScatter::Type::Absorbed) break;
+            beta *= s.weight;
+            specular = s.type == SurfaceScatter::Type::Specular;
+            if (!specular) prevPdf = std::abs(dot(s.next.d, hit.ns)) * InvPi;
+            ray = s.next;
+            tMin = 0;
+            tMax = Infinity;
+            firstSegment = false;
+            if (!roulette(beta, depth, rng)) break;
+        }
+        return out;
+    }
+
+private:
+    bool roulette(Spectrum& beta, int depth, Rng& rng) const {
+        if (depth < settings_.rouletteDepth) return true;
+        double q = std::max(0.0, 1 - beta.maxValue());
+        if (q <= 0) return true;
+        if (rng.uniform() < q) return false;
+        beta /= 1 - q;
+        return true;
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings) {
+    return std::make_unique<PathTracer>(scene, settings);
+}
+
+}  // namespace volphoton

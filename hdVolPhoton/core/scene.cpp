@@ -1,0 +1,176 @@
+#include "core/scene.h"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "core/diagnostics.h"
+
+namespace volphoton {
+
+namespace {
+void embreeError(void*, RTCError code, const char* str) {
+    warn(std::string("embree error ") + std::to_string(static_cast<int>(code)) + ": " + (str ? str : ""));
+}
+}  // namespace
+
+Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
+    device_ = rtcNewDevice("verbose=0");
+    if (!device_) throw std::runtime_error("cannot create an Embree device");
+    rtcSetDeviceErrorFunction(device_, embreeError, nullptr);
+    top_ = rtcNewScene(device_);
+
+    for (auto& m : desc_.media)
+        if (!m) throw std::invalid_argument("scene: null medium");
+    Bounds3 bounds;
+    for (size_t mi = 0; mi < desc_.meshes.size(); ++mi) {
+        MeshDesc& m = desc_.meshes[mi];
+        if (m.indices.size() % 3) throw std::invalid_argument("mesh '" + m.name + "': index count is not a multiple of 3");
+        for (uint32_t i : m.indices)
+            if (i >= m.points.size()) throw std::invalid_argument("mesh '" + m.name + "': index out of range");
+        for (const Vec3& p : m.points)
+            if (!isFinite(p)) throw std::invalid_argument("mesh '" + m.name + "': non-finite point");
+        if (!m.normals.empty() && m.normals.size() != m.points.size()) {
+            warn("mesh '" + m.name + "': normals count does not match points; using face normals");
+            m.normals.clear();
+        }
+        if (m.interiorMedium >= static_cast<int>(desc_.media.size()))
+            throw std::invalid_argument("mesh '" + m.name + "': interior medium index out of range");
+        RTCScene s = rtcNewScene(device_);
+        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.points.size()));
+        for (size_t i = 0; i < m.points.size(); ++i) {
+            v[3 * i] = static_cast<float>(m.points[i].x);
+            v[3 * i + 1] = static_cast<float>(m.points[i].y);
+            v[3 * i + 2] = static_cast<float>(m.points[i].z);
+        }
+        unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.indices.size() / 3));
+        std::copy(m.indices.begin(), m.indices.end(), idx);
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(s, g);
+        rtcReleaseGeometry(g);
+        rtcCommitScene(s);
+        meshScenes_.push_back(s);
+    }
+    for (size_t ii = 0; ii < desc_.instances.size(); ++ii) {
+        const InstanceDesc& inst = desc_.instances[ii];
+        if (inst.mesh < 0 || inst.mesh >= static_cast<int>(meshScenes_.size()))
+            throw std::invalid_argument("instance " + std::to_string(ii) + ": mesh index out of range");
+        auto inv = inst.transform.inverse();
+        if (!inv) {
+            warn("instance " + std::to_string(ii) + " of mesh '" + desc_.meshes[inst.mesh].name +
+                 "': transform is not invertible or not finite; the instance is skipped");
+            instanceInverse_.push_back(Affine());
+            continue;
+        }
+        instanceInverse_.push_back(*inv);
+        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(g, meshScenes_[inst.mesh]);
+        float xfm[12];  // column-major 3x4
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = static_cast<float>(inst.transform.m[r][c]);
+        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(top_, g, static_cast<unsigned>(ii));
+        rtcReleaseGeometry(g);
+        for (const Vec3& p : desc_.meshes[inst.mesh].points) bounds.extend(inst.transform.point(p));
+    }
+    rtcCommitScene(top_);
+
+    for (int i : desc_.unboundedMedia) {
+        if (i < 0 || i >= static_cast<int>(desc_.media.size())) throw std::invalid_argument("scene: unbounded medium index out of range");
+        Bounds3 b = desc_.media[i]->bounds();
+        if (isFinite(b.lo) && isFinite(b.hi)) bounds.extend(b);
+    }
+    for (const auto& m : desc_.media) emissiveMedia_ |= m->isEmissive();
+    hasMedia_ = !desc_.unboundedMedia.empty();
+    for (const auto& m : desc_.meshes) hasMedia_ |= m.interiorMedium >= 0;
+    if (bounds.empty()) bounds.extend(Vec3(0, 0, 0));
+    center_ = (bounds.lo + bounds.hi) * 0.5;
+    radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
+    double extent = std::max({std::abs(bounds.lo.x), std::abs(bounds.lo.y), std::abs(bounds.lo.z), std::abs(bounds.hi.x),
+                              std::abs(bounds.hi.y), std::abs(bounds.hi.z), radius_});
+    epsilon_ = 1e-5 * extent;  // Embree works in single precision: offsets relative to the scene's extent
+}
+
+Scene::~Scene() {
+    for (RTCScene s : meshScenes_) rtcReleaseScene(s);
+    if (top_) rtcReleaseScene(top_);
+    if (device_) rtcReleaseDevice(device_);
+}
+
+bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit) const {
+    if (desc_.instances.empty()) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = static_cast<float>(ray.o.x);
+    rh.ray.org_y = static_cast<float>(ray.o.y);
+    rh.ray.org_z = static_cast<float>(ray.o.z);
+    rh.ray.dir_x = static_cast<float>(ray.d.x);
+    rh.ray.dir_y = static_cast<float>(ray.d.y);
+    rh.ray.dir_z = static_cast<float>(ray.d.z);
+    rh.ray.tnear = static_cast<float>(tMin);
+    rh.ray.tfar = std::isinf(tMax) ? std::numeric_limits<float>::infinity() : static_cast<float>(tMax);
+    rh.ray.mask = ~0u;
+    rh.ray.flags = 0;
+    rh.ray.time = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(top_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    int inst = static_cast<int>(rh.hit.instID[0]);
+    const InstanceDesc& id = desc_.instances[inst];
+    const MeshDesc& m = desc_.meshes[id.mesh];
+    hit->t = rh.ray.tfar;
+    hit->p = ray.at(hit->t);
+    hit->mesh = id.mesh;
+    hit->instance = inst;
+    uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1], i2 = m.indices[3 * rh.hit.primID + 2];
+    Vec3 nObj = cross(m.points[i1] - m.points[i0], m.points[i2] - m.points[i0]);
+    Vec3 ng = Affine::normal(instanceInverse_[inst], nObj);
+    double len = length(ng);
+    hit->ng = len > 0 ? ng / len : Vec3(0, 0, 1);
+    hit->ns = hit->ng;
+    if (!m.normals.empty()) {
+        double u = rh.hit.u, v = rh.hit.v;
+        Vec3 n = m.normals[i0] * (1 - u - v) + m.normals[i1] * u + m.normals[i2] * v;
+        Vec3 ns = Affine::normal(instanceInverse_[inst], n);
+        double l = length(ns);
+        if (l > 0 && std::isfinite(l)) {
+            ns = ns / l;
+            hit->ns = dot(ns, hit->ng) < 0 ? -ns : ns;
+        }
+    }
+    return true;
+}
+
+MediumAggregate Scene::mediaFor(const MediumStack& stack) const {
+    MediumAggregate agg;
+    for (int i : desc_.unboundedMedia) agg.add(desc_.media[i].get());
+    int inner = stack.innermost();
+    if (inner >= 0 && desc_.meshes[inner].interiorMedium >= 0) agg.add(desc_.media[desc_.meshes[inner].interiorMedium].get());
+    return agg;
+}
+
+MediumStack Scene::stackAt(const Vec3& p) const {
+    MediumStack stack;
+    // Parity along a fixed, non-axis-aligned probe direction; the nearest first crossing of a
+    // containing mesh belongs to the innermost one, so containing meshes are pushed far to near.
+    Ray probe{p, normalize(Vec3(0.5773, 0.5774, 0.5775))};
+    std::vector<std::pair<int, double>> crossings;  // mesh, first t
+    std::vector<int> parity(desc_.meshes.size(), 0);
+    double t = 0;
+    SurfaceHit hit;
+    for (int n = 0; n < 1024 && intersect(probe, t, Infinity, &hit); ++n) {
+        if (desc_.meshes[hit.mesh].material.kind != SurfaceMaterial::Kind::Lambertian) {
+            if (parity[hit.mesh]++ == 0) crossings.push_back({hit.mesh, hit.t});
+        }
+        t = hit.t + epsilon_;
+    }
+    std::sort(crossings.begin(), crossings.end(), [](auto& a, auto& b) { return a.second > b.second; });
+    for (auto& [mesh, first] : crossings)
+        if (parity[mesh] % 2 == 1) stack.toggle(mesh);
+    return stack;
+}
+
+}  // namespace volphoton

@@ -1,0 +1,130 @@
+// The renderer's scene: plain description structs that any front end fills (the usd-core front end
+// through the Python bindings, the Hydra delegate in Sync), and the Scene built from them once:
+// Embree BVH over instanced triangle meshes, lights, media.
+//
+// Surface materials:
+// | kind        | fields            | meaning                                                         |
+// |-------------|-------------------|-----------------------------------------------------------------|
+// | lambertian  | albedo, emission  | diffuse reflector; emission is radiance leaving the front side   |
+// | dielectric  | ior               | smooth Fresnel interface (glass, a translucent object's surface) |
+// | boundary    |                   | index-matched (ior = 1) medium container: invisible to light     |
+// A mesh with an interior medium (index into SceneDesc::media) bounds it; it must be closed. Media
+// listed in unboundedMedia (volumes, atmospheres, camera fog) are bounded by their own bounds.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/lights.h"
+#include "core/medium.h"
+#include "core/mediumAggregate.h"
+
+namespace volphoton {
+
+struct SurfaceMaterial {
+    enum class Kind { Lambertian, Dielectric, Boundary };
+    Kind kind = Kind::Lambertian;
+    Spectrum albedo{0.5};
+    Spectrum emission{0.0};
+    double ior = 1.5;
+};
+
+struct MeshDesc {
+    std::string name;
+    std::vector<Vec3> points;
+    std::vector<uint32_t> indices;  ///< triangles
+    std::vector<Vec3> normals;      ///< optional, per vertex
+    SurfaceMaterial material;
+    int interiorMedium = -1;  ///< index into SceneDesc::media, or -1
+};
+
+struct InstanceDesc {
+    int mesh = 0;
+    Affine transform;
+};
+
+struct SceneDesc {
+    std::vector<MeshDesc> meshes;
+    std::vector<InstanceDesc> instances;  ///< a mesh with no instance is not rendered
+    std::vector<MediumPtr> media;
+    std::vector<int> unboundedMedia;
+    std::vector<LightPtr> lights;
+    CameraDesc camera;
+};
+
+struct SurfaceHit {
+    double t = Infinity;
+    Vec3 p;
+    Vec3 ng;  ///< geometric normal, unit, facing as authored
+    Vec3 ns;  ///< shading normal, unit, same side as ng
+    int mesh = -1;
+    int instance = -1;
+};
+
+/// The closed dielectric and boundary meshes the path is inside, innermost last. Crossing one toggles
+/// it (robust to either winding). The innermost mesh's interior medium replaces enclosing ones
+/// (nesting, not overlap); a dielectric with no medium is a clear interior.
+struct MediumStack {
+    static constexpr int MaxDepth = 8;
+    int mesh[MaxDepth];
+    int size = 0;
+    void toggle(int meshIndex) {
+        for (int i = 0; i < size; ++i)
+            if (mesh[i] == meshIndex) {
+                for (int j = i; j + 1 < size; ++j) mesh[j] = mesh[j + 1];
+                --size;
+                return;
+            }
+        if (size < MaxDepth) mesh[size++] = meshIndex;
+    }
+    int innermost() const { return size ? mesh[size - 1] : -1; }
+    bool contains(int meshIndex) const {
+        for (int i = 0; i < size; ++i)
+            if (mesh[i] == meshIndex) return true;
+        return false;
+    }
+};
+
+/// \class Scene
+/// Built once from a SceneDesc (validating it) and then immutable; shared by render threads.
+class Scene {
+public:
+    explicit Scene(SceneDesc desc);
+    ~Scene();
+    Scene(const Scene&) = delete;
+    Scene& operator=(const Scene&) = delete;
+
+    bool intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit) const;
+    /// Media along a segment: the unbounded ones plus the innermost interior medium of the stack.
+    MediumAggregate mediaFor(const MediumStack& stack) const;
+    /// Stack of closed dielectric/boundary meshes containing p, found by parity along a probe ray.
+    MediumStack stackAt(const Vec3& p) const;
+
+    const SceneDesc& desc() const { return desc_; }
+    const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
+    const std::vector<LightPtr>& lights() const { return desc_.lights; }
+    bool hasMedia() const { return hasMedia_; }
+    bool hasSurfaces() const { return !desc_.instances.empty(); }
+    bool hasEmissiveMedia() const { return emissiveMedia_; }
+    /// Bounding sphere of geometry and bounded media (for distant and dome light photons).
+    Vec3 center() const { return center_; }
+    double radius() const { return radius_; }
+    /// Scale of the scene for ray offsets.
+    double epsilon() const { return epsilon_; }
+
+private:
+    SceneDesc desc_;
+    RTCDevice device_ = nullptr;
+    RTCScene top_ = nullptr;
+    std::vector<RTCScene> meshScenes_;
+    std::vector<Affine> instanceInverse_;
+    bool hasMedia_ = false, emissiveMedia_ = false;
+    Vec3 center_;
+    double radius_ = 1, epsilon_ = 1e-6;
+};
+
+}  // namespace volphoton

@@ -1,0 +1,1 @@
+"""hdVolPhoton Python tools: USD schema reader/validator (volphoton.schema) and helpers."""
