@@ -1,0 +1,50 @@
+// Volume photon map with beam queries: every photon is a disc of radius r facing the query ray, kept
+// in an Embree BVH (RTC_GEOMETRY_TYPE_DISC_POINT), so one traversal finds every photon within r of a
+// ray segment (Jarosz, Zwicker and Jensen 2008, "The Beam Radiance Estimate for Volumetric Photon
+// Mapping"). The intersection filter records each disc and rejects it so traversal goes on.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <vector>
+
+#include "core/functionRef.h"
+#include "core/math.h"
+#include "core/phase.h"
+
+namespace volphoton {
+
+/// A photon stored at a volume scattering event. `power` already includes the scattering coefficient
+/// of the lobe it stands for, so sum(power * p(cos) * kernel) estimates the in-scattered source term.
+struct Photon {
+    float p[3];
+    float dir[3];  ///< propagation direction before the event
+    float power[3];
+    const PhaseFunction* phase;
+    int region;  ///< innermost medium mesh at the photon (-1: outside every mesh)
+};
+
+/// \class PhotonMap
+/// Built once per pass from that pass's photons, then queried concurrently.
+class PhotonMap {
+public:
+    PhotonMap(std::vector<Photon> photons, double radius);
+    ~PhotonMap();
+    PhotonMap(const PhotonMap&) = delete;
+    PhotonMap& operator=(const PhotonMap&) = delete;
+
+    /// Calls visit(photon, t along the ray, squared distance to the ray) for every photon within the
+    /// radius of the segment ray.o + t ray.d, t in [tMin, tMax].
+    void query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const Photon&, double, double)> visit) const;
+    double radius() const { return radius_; }
+    size_t size() const { return photons_.size(); }
+    size_t bytes() const { return photons_.capacity() * sizeof(Photon) + photons_.size() * 16 * 2; }
+
+private:
+    std::vector<Photon> photons_;
+    double radius_;
+    RTCDevice device_ = nullptr;
+    RTCScene scene_ = nullptr;
+};
+
+}  // namespace volphoton

@@ -1,0 +1,458 @@
+// Integrator 2: photon mapping with separate single- and multiple-scattering passes.
+//
+//  - Single scattering: each camera segment inside media is ray marched with stratified jittered
+//    steps; at each step one light (picked by power among lights with extent and distant/dome lights)
+//    is sampled with a shadow ray. Point and spot lights are handled by equiangular sampling of the
+//    segment instead (Kulla and Fajardo 2012), one sample per point light per segment.
+//  - Multiple scattering: photons leave the lights in proportion to power, fly through the core's
+//    free-flight routine with spectral tracking (for grey media that is d = -ln(xi)/sigma_t with
+//    absorption by Russian roulette on the albedo), and are stored at volume scattering events once
+//    they have scattered or bounced before (the first event from direct light is the single pass's).
+//    Camera segments gather them with the beam radiance estimate (photonMap.h); the radius shrinks
+//    per pass as r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1) (Knaus and Zwicker 2011, 2D kernel), so the
+//    average over passes converges.
+//  - Surfaces: direct light by light sampling; indirect light by continuing the camera path with a
+//    diffuse bounce, whose media segments again get single + multiple estimates. So surfaces lit by
+//    media and media lit through surfaces are both counted, each exactly once.
+//  - Camera transmittance: closed form where the media have one, else the marched optical depth.
+//    Early termination: below a transmittance of 1e-3 the march continues with probability 1/2 and
+//    doubled weight (Russian roulette, unbiased given the march); `transmittanceCutoff` stops it
+//    outright instead (BIASED).
+//
+// XXX: volume emission is added along camera segments but emissive media emit no photons, so light
+//      scattered from emissive media is missing here; the renderer warns and the path tracer has it.
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <mutex>
+
+#include "core/diagnostics.h"
+#include "core/freeFlight.h"
+#include "core/integratorBase.h"
+#include "core/photonMap.h"
+
+namespace volphoton {
+namespace {
+
+constexpr int PhotonBatch = 4096;
+
+class PhotonMapper final : public Integrator {
+public:
+    PhotonMapper(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
+        double diameter = 2 * scene.radius();
+        radius_ = settings.initialRadius > 0 ? settings.initialRadius : diameter / 100;
+        step_ = settings.marchStep > 0 ? settings.marchStep : diameter / 256;
+        std::vector<double> extended, point;
+        for (const LightPtr& l : scene.lights()) {
+            bool isPoint = l->isDelta() && l->describe() != "distant";
+            double p = l->power(scene.radius()).average();
+            extended.push_back(isPoint ? 0.0 : p);
+            if (isPoint) pointLights_.push_back(static_cast<int>(&l - &scene.lights()[0]));
+        }
+        hasExtended_ = false;
+        for (double p : extended) hasExtended_ |= p > 0;
+        if (hasExtended_) extendedDist_ = Distribution1D(extended);
+        hasMeshMedia_ = false;
+        for (const MeshDesc& m : scene.desc().meshes) hasMeshMedia_ |= m.material.kind != SurfaceMaterial::Kind::Lambertian;
+    }
+
+    bool beginPass(int pass, RenderStats& stats, const CancelCallback& cancel) override {
+        if (pass == 0) decidePasses(stats);
+        if (!photonsEnabled_) return true;
+        double r = radius_;
+        for (int i = 0; i < pass; ++i) r *= std::sqrt((i + settings_.radiusAlpha) / (i + 1));
+        std::vector<Photon> photons;
+        uint64_t traced = 0;
+        if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel)) return false;
+        map_ = std::make_unique<PhotonMap>(std::move(photons), r);
+        stats.photonsTraced += traced;
+        stats.photonsStored += map_->size();
+        stats.photonRadius = r;
+        stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
+        return true;
+    }
+
+    PathRadiance Li(const Ray& cameraRay, double tMin, double tMax, Rng& rng) const override {
+        PathRadiance out;
+        Ray ray = cameraRay;
+        Spectrum beta(1.0);
+        MediumStack stack = cameraStack_;
+        bool firstSegment = true, onlySpecular = true;
+        int depth = 0, crossings = 0;
+        // Which AOV a contribution goes to: the first non-boundary vertex decides (integrator.h).
+        auto route = [&](Spectrum& medium) -> Spectrum& { return firstSegment ? medium : out.surface; };
+
+        while (true) {
+            SurfaceHit hit;
+            bool hasHit = scene_.intersect(ray, tMin, tMax, &hit);
+            double tEnd = hasHit ? hit.t : tMax;
+            double tLight;
+            Spectrum lightLe;
+            double lightPdf;
+            int light = -1;
+            bool hasLight = hitLight(ray, tEnd, &tLight, &lightLe, &lightPdf, &light);
+            if (hasLight && !std::isinf(tLight)) tEnd = tLight;
+            if (firstSegment && hasHit) out.depth = hit.t;
+
+            Spectrum Tseg(1.0);
+            if (scene_.hasMedia()) {
+                MediumAggregate media = scene_.mediaFor(stack);
+                if (media.size()) {
+                    Ray local{ray.at(tMin), ray.d};
+                    double length = std::isinf(tEnd) ? 1e30 : tEnd - tMin;
+                    SegmentResult seg = integrateSegment(media, local, length, stack, rng);
+                    route(out.single) += beta * seg.single;
+                    route(out.multiple) += beta * seg.multiple;
+                    route(out.emission) += beta * seg.emission;
+                    if (firstSegment && seg.interacted) out.alpha = 1;
+                    Tseg = seg.T;
+                }
+            }
+            beta *= Tseg;
+            if (beta.isBlack()) break;
+            if (hasLight && (!hasHit || tLight <= hit.t)) {
+                // Lights are found by light sampling at diffuse vertices, so a hit counts only after
+                // the camera or specular bounces.
+                if (onlySpecular) out.surface += beta * lightLe;
+                if (firstSegment && !std::isinf(tLight)) out.alpha = 1;
+                break;
+            }
+            if (!hasHit) break;
+            if (firstSegment) out.alpha = 1;
+            const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+            if (m.kind == SurfaceMaterial::Kind::Boundary) {
+                if (++crossings > 256) break;
+                SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
+                ray = s.next;
+                tMin = 0;
+                tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
+                continue;
+            }
+            firstSegment = false;
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
+                out.surface += beta * m.emission;
+            if (++depth > settings_.maxDepth) break;
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack()) {
+                DirectSample ds = sampleDirect(hit.p, rng);
+                Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
+                double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
+                if (cosL > 0 && ds.ls.pdf > 0 && dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) > 0) {
+                    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
+                    out.surface += beta * m.albedo * (cosL * InvPi) * T * ds.ls.Li / (ds.pickProb * ds.ls.pdf);
+                }
+            }
+            SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
+            if (s.type == SurfaceScatter::Type::Absorbed) break;
+            beta *= s.weight;
+            onlySpecular = onlySpecular && s.type == SurfaceScatter::Type::Specular;
+            ray = s.next;
+            tMin = 0;
+            tMax = Infinity;
+            if (depth >= settings_.rouletteDepth) {
+                double q = std::max(0.0, 1 - beta.maxValue());
+                if (rng.uniform() < q) break;
+                beta /= 1 - q;
+            }
+        }
+        return out;
+    }
+
+private:
+    struct SegmentResult {
+        Spectrum single, multiple, emission;
+        Spectrum T{1.0};
+        bool interacted = false;
+    };
+
+    /// Per-segment transmittance from the segment start: closed form if the media have one, else the
+    /// march's cumulative optical depth, linearly interpolated.
+    struct SegmentTransmittance {
+        const Medium* media = nullptr;
+        const Ray* ray = nullptr;
+        bool closedForm = false;
+        std::vector<double> t, tau[3];
+        Spectrum at(double x) const {
+            if (closedForm) return exp(-*media->opticalDepth(*ray, 0.0, x));
+            if (t.empty() || x <= t.front()) return Spectrum(1.0);
+            size_t i = std::upper_bound(t.begin(), t.end(), x) - t.begin();
+            Spectrum depth;
+            for (int c = 0; c < 3; ++c) {
+                if (i >= t.size()) depth[c] = tau[c].back();
+                else {
+                    double f = (x - t[i - 1]) / (t[i] - t[i - 1]);
+                    depth[c] = tau[c][i - 1] + f * (tau[c][i] - tau[c][i - 1]);
+                }
+            }
+            return exp(-depth);
+        }
+    };
+
+    SegmentResult integrateSegment(const MediumAggregate& media, const Ray& ray, double length, const MediumStack& stack, Rng& rng) const {
+        SegmentResult r;
+        SegmentTransmittance tr;
+        tr.media = &media;
+        tr.ray = &ray;
+        tr.closedForm = static_cast<bool>(media.opticalDepth(ray, 0.0, 0.0));
+        bool emissive = media.isEmissive();
+        bool single = settings_.singleScattering;
+        double weight = 1.0;  // Russian-roulette weight of the march's early termination
+        Spectrum tauRun;      // marched optical depth so far
+        double supportStart = Infinity, supportEnd = 0;
+        bool stop = false;
+        double offsetU = rng.uniform();
+        media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
+            supportStart = std::min(supportStart, seg.tMin);
+            supportEnd = std::max(supportEnd, seg.tMax);
+            double len = seg.tMax - seg.tMin;
+            int n = static_cast<int>(std::clamp(std::ceil(len / step_), 1.0, 1e5));
+            double dt = len / n;
+            for (int i = 0; i < n && !stop; ++i) {
+                double t = seg.tMin + (i + offsetU) * dt;
+                Vec3 p = ray.at(t);
+                MediumProperties mp = media.properties(p);
+                Spectrum sigma_t = mp.sigma_t();
+                Spectrum T = tr.closedForm ? tr.at(t) : exp(-(tauRun + sigma_t * (offsetU * dt)));
+                if (!tr.closedForm) {
+                    tauRun += sigma_t * dt;
+                    tr.t.push_back(seg.tMin + (i + 1) * dt);
+                    for (int c = 0; c < 3; ++c) tr.tau[c].push_back(tauRun[c]);
+                }
+                if (!sigma_t.isBlack()) r.interacted = true;
+                if (emissive) r.emission += mp.emission * T * (dt * weight);
+                if (single && hasExtended_ && !mp.sigma_s.isBlack()) r.single += directExtended(p, ray.d, mp, stack, rng) * T * (dt * weight);
+                // Early termination of the march.
+                double Tmax = T.maxValue() * weight;
+                if (Tmax < settings_.transmittanceCutoff) { stop = true; break; }
+                if (Tmax < 1e-3) {
+                    if (rng.uniform() < 0.5) { stop = true; break; }
+                    weight *= 2;
+                }
+            }
+            return !stop;
+        });
+        if (supportEnd <= supportStart) return r;
+        r.T = stop ? Spectrum(0.0) : tr.at(length);
+        if (tr.closedForm && !stop) r.T = exp(-*media.opticalDepth(ray, 0.0, length));
+        if (!tr.closedForm && !stop) r.T = exp(-tauRun);
+        if (single)
+            for (int light : pointLights_) r.single += equiangular(light, media, ray, supportStart, std::min(supportEnd, length), tr, stack, rng);
+        if (map_) r.multiple = gather(ray, supportStart, std::min(supportEnd, length), tr, stack);
+        return r;
+    }
+
+    /// Light from one light with extent or a distant/dome light, sampled at p and scattered towards
+    /// the camera (direction -d): sigma_s p L T / pdf.
+    Spectrum directExtended(const Vec3& p, const Vec3& d, const MediumProperties& mp, const MediumStack& stack, Rng& rng) const {
+        double pick;
+        size_t li = extendedDist_.sampleDiscrete(rng.uniform(), &pick);
+        double u1 = rng.uniform(), u2 = rng.uniform();
+        LightSample ls = scene_.lights()[li]->sample(p, u1, u2);
+        if (!(ls.pdf > 0) || ls.Li.isBlack()) return {};
+        Spectrum f = mp.scatterKernel(dot(d, ls.wi));
+        if (f.isBlack()) return {};
+        Spectrum T = shadowTransmittance(p, ls.wi, ls.dist, stack, rng);
+        return f * T * ls.Li / (pick * ls.pdf);
+    }
+
+    /// Equiangular sampling of [a, b] for a point light (Kulla and Fajardo 2012, eq. 6-7).
+    Spectrum equiangular(int light, const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
+                         const MediumStack& stack, Rng& rng) const {
+        if (!(b > a)) return {};
+        const Light& L = *scene_.lights()[light];
+        LightSample probe = L.sample(ray.o, 0.5, 0.5);
+        Vec3 lp = ray.o + probe.wi * probe.dist;
+        double delta = dot(lp - ray.o, ray.d);
+        double D = length(lp - ray.at(delta));
+        double t, pdf;
+        double u = rng.uniform();
+        if (D < 1e-9 * (1 + std::abs(delta))) {  // the ray passes through the light: uniform fallback
+            t = a + u * (b - a);
+            pdf = 1 / (b - a);
+        } else {
+            double thA = std::atan2(a - delta, D), thB = std::atan2(b - delta, D);
+            t = delta + D * std::tan(thA + u * (thB - thA));
+            pdf = D / ((thB - thA) * (D * D + (t - delta) * (t - delta)));
+        }
+        Vec3 p = ray.at(t);
+        MediumProperties mp = media.properties(p);
+        if (mp.sigma_s.isBlack()) return {};
+        LightSample ls = L.sample(p, rng.uniform(), rng.uniform());
+        if (!(ls.pdf > 0) || ls.Li.isBlack()) return {};
+        Spectrum f = mp.scatterKernel(dot(ray.d, ls.wi));
+        Spectrum T = shadowTransmittance(p, ls.wi, ls.dist, stack, rng);
+        return tr.at(t) * f * T * ls.Li / (ls.pdf * pdf);
+    }
+
+    Spectrum gather(const Ray& ray, double a, double b, const SegmentTransmittance& tr, const MediumStack& stack) const {
+        Spectrum sum;
+        int region = stack.innermost();
+        double invArea = 1 / (Pi * map_->radius() * map_->radius());
+        map_->query(ray, a, b, [&](const Photon& ph, double t, double) {
+            if (ph.region != region) return;
+            double cosTheta = -(ph.dir[0] * ray.d.x + ph.dir[1] * ray.d.y + ph.dir[2] * ray.d.z);
+            double p = ph.phase->eval(std::clamp(cosTheta, -1.0, 1.0));
+            sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * tr.at(t) * (p * invArea);
+        });
+        return sum;
+    }
+
+    /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
+    /// (index 0) and at stored events (index 1).
+    bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel) const {
+        if (!lightDist_.size() || count <= 0) return true;
+        int batches = (count + PhotonBatch - 1) / PhotonBatch;
+        std::vector<std::vector<Photon>> perBatch(batches);
+        std::vector<std::array<double, 2>> perEnergy(batches, {0.0, 0.0});
+        std::atomic<bool> cancelled{false};
+        tbb::parallel_for(0, batches, [&](int b) {
+            if (cancelled || (cancel && cancel())) { cancelled = true; return; }
+            Rng rng(hashKeys(0x50484f54ULL, settings_.seed, pass, b, energy ? 1 : 0));
+            int n = std::min(PhotonBatch, count - b * PhotonBatch);
+            for (int i = 0; i < n; ++i) tracePhoton(rng, count, &perBatch[b], perEnergy[b].data());
+        });
+        if (cancelled) return false;
+        for (int b = 0; b < batches; ++b) {
+            photons->insert(photons->end(), perBatch[b].begin(), perBatch[b].end());
+            if (energy) { energy[0] += perEnergy[b][0]; energy[1] += perEnergy[b][1]; }
+        }
+        *traced += count;
+        return true;
+    }
+
+    void tracePhoton(Rng& rng, int count, std::vector<Photon>* out, double energy[2]) const {
+        double pick;
+        size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
+        double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+        PhotonEmission e = scene_.lights()[li]->emitPhoton(scene_.center(), scene_.radius(), u);
+        Spectrum flux = e.flux / (pick * count);
+        if (flux.isBlack() || !flux.isFinite()) return;
+        Ray ray = e.ray;
+        MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
+        int events = 0;  // scatterings and diffuse bounces so far
+        for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < 256;) {
+            SurfaceHit hit;
+            bool hasHit = scene_.intersect(ray, 0.0, Infinity, &hit);
+            bool scattered = false, absorbed = false;
+            MediumEvent ev{};
+            MediumAggregate media = scene_.mediaFor(stack);
+            if (media.size()) {
+                sampleFreeFlight(media, ray, hasHit ? hit.t : 1e30, rng, [&](const MediumEvent& m) {
+                    Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
+                    for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
+                    double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
+                    double pn = (sigma_n * flux).average(), total = pa + ps + pn;
+                    if (!(total > 0)) { absorbed = true; return false; }
+                    double x = rng.uniform() * total;
+                    if (x < pa) { absorbed = true; return false; }
+                    if (x < pa + ps) { flux *= total / (m.sigmaMaj * ps); ev = m; scattered = true; return false; }
+                    flux *= sigma_n * (total / (m.sigmaMaj * pn));
+                    return true;
+                });
+            }
+            if (absorbed) return;
+            if (scattered) {
+                const MediumProperties& mp = ev.mp;
+                // Pick the lobe this event stands for in proportion to its average sigma_s.
+                double total = 0;
+                for (int l = 0; l < mp.lobeCount; ++l) total += mp.lobes[l].sigma_s.average();
+                if (!(total > 0)) return;
+                double x = rng.uniform() * total;
+                int lobe = mp.lobeCount - 1;
+                for (int l = 0; l < mp.lobeCount; ++l) {
+                    x -= mp.lobes[l].sigma_s.average();
+                    if (x < 0) { lobe = l; break; }
+                }
+                double lobeProb = mp.lobes[lobe].sigma_s.average() / total;
+                Spectrum stored = flux * mp.lobes[lobe].sigma_s / lobeProb;
+                if (energy) energy[events >= 1 ? 1 : 0] += (flux * mp.sigma_s).average();
+                if (events >= 1) {
+                    Photon ph;
+                    for (int c = 0; c < 3; ++c) {
+                        ph.p[c] = static_cast<float>(ev.p[c]);
+                        ph.dir[c] = static_cast<float>(ray.d[c]);
+                        ph.power[c] = static_cast<float>(stored[c]);
+                    }
+                    ph.phase = mp.lobes[lobe].phase;
+                    ph.region = stack.innermost();
+                    out->push_back(ph);
+                }
+                ++events;
+                ++depth;
+                Vec3 w = mp.sampleScatter(ray.d, rng.uniform(), rng.uniform(), rng.uniform());
+                double cosTheta = dot(ray.d, w), pdf = mp.scatterPdf(cosTheta);
+                if (!(pdf > 0)) return;
+                // flux carries 1/(sigma_maj P_s) from spectral tracking; the kernel brings sigma_s.
+                flux *= mp.scatterKernel(cosTheta) / pdf;
+                for (int c = 0; c < 3; ++c) if (!std::isfinite(flux[c])) flux[c] = 0;
+                ray = {ev.p, w};
+                continue;
+            }
+            if (!hasHit) return;
+            const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+            SurfaceScatter s = scatterSurface(ray, hit, stack, rng, false);
+            if (s.type == SurfaceScatter::Type::Absorbed) return;
+            if (s.type == SurfaceScatter::Type::Pass) { ++crossings; ray = s.next; continue; }
+            ++depth;
+            if (m.kind == SurfaceMaterial::Kind::Lambertian) {
+                ++events;
+                // Russian roulette on the reflectance keeps photon power roughly constant.
+                double q = std::clamp(s.weight.average(), 0.0, 1.0);
+                if (rng.uniform() >= q) return;
+                flux *= s.weight / q;
+            } else {
+                flux *= s.weight;
+            }
+            ray = s.next;
+        }
+    }
+
+    void decidePasses(RenderStats& stats) {
+        stats.passesRun.push_back("camera");
+        if (!scene_.hasMedia()) {
+            stats.passesSkipped.push_back("single scattering: the scene has no media");
+            stats.passesSkipped.push_back("multiple scattering (photons): the scene has no media");
+            settings_.singleScattering = false;
+            return;
+        }
+        if (settings_.singleScattering) stats.passesRun.push_back("single scattering");
+        else stats.passesSkipped.push_back("single scattering: disabled by settings");
+        if (scene_.hasEmissiveMedia())
+            warn("photonMap integrator: light scattered from emissive media is not traced (XXX); use the pathTracer for emissive scattering media");
+        if (!settings_.multipleScattering) { stats.passesSkipped.push_back("multiple scattering (photons): disabled by settings"); return; }
+        if (!lightDist_.size() || settings_.photonsPerPass == 0) { stats.passesSkipped.push_back("multiple scattering (photons): no lights or no photons"); return; }
+        double maxAlbedo = 0;
+        for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
+        if (maxAlbedo == 0) { stats.passesSkipped.push_back("multiple scattering (photons): every medium has albedo 0"); return; }
+        // Pilot: the energy reaching second and later scattering events relative to first events.
+        std::vector<Photon> pilot;
+        uint64_t traced = 0;
+        double energy[2] = {0, 0};
+        tracePhotons(-1, 4096, &pilot, &traced, energy, {});
+        stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : 0.0;
+        if (energy[0] == 0 && energy[1] == 0) {
+            stats.passesSkipped.push_back("multiple scattering (photons): no pilot photon scattered in a medium");
+            return;
+        }
+        if (stats.multipleToSingleRatio < settings_.multipleThreshold) {
+            stats.passesSkipped.push_back("multiple scattering (photons): pilot estimate of multiple/single energy " +
+                                          std::to_string(stats.multipleToSingleRatio) + " is below multipleThreshold");
+            return;
+        }
+        photonsEnabled_ = true;
+        stats.passesRun.push_back("multiple scattering (photons)");
+    }
+
+    double radius_, step_;
+    std::vector<int> pointLights_;
+    Distribution1D extendedDist_;
+    bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false;
+    std::unique_ptr<PhotonMap> map_;
+};
+
+}  // namespace
+
+std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings) {
+    return std::make_unique<PhotonMapper>(scene, settings);
+}
+
+}  // namespace volphoton
