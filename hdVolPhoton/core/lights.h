@@ -12,6 +12,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,8 @@ public:
     /// solid-angle density sample() would have produced the direction with.
     virtual bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const = 0;
     virtual bool isDelta() const = 0;
+    /// Position of a point (or point spot) light, for equiangular sampling; nullopt for others.
+    virtual std::optional<Vec3> pointPosition() const { return std::nullopt; }
     /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
     virtual Spectrum power(double sceneRadius) const = 0;
     virtual PhotonEmission emitPhoton(const Vec3& sceneCenter, double sceneRadius, double u[4]) const = 0;

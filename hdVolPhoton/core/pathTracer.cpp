@@ -9,7 +9,10 @@
 // collision as beta * emission / sigma_maj (pbrt-v4's VolPathIntegrator does the same).
 // Direct light: next-event estimation with shadow transmittance (closed form where the media have one,
 // else ratio tracking), combined with phase/BSDF sampling by MIS (power heuristic) for lights with
-// extent; delta lights by light sampling alone.
+// extent. Point and spot lights (delta) add a second strategy on every segment in a medium:
+// equiangular sampling of the distance (Kulla and Fajardo 2012), combined with the NEE at real
+// collisions by one-sample MIS (balance heuristic) against the free-flight density.
+// XXX: sphere lights with a radius use NEE + phase MIS only, not equiangular sampling.
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
 
@@ -20,7 +23,14 @@ enum class Branch { Undecided, Medium, Surface };
 
 class PathTracer final : public Integrator {
 public:
-    using Integrator::Integrator;
+    PathTracer(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
+        for (const LightPtr& l : scene.lights()) {
+            std::optional<Vec3> position = l->pointPosition();
+            pointLight_.push_back(position.has_value());
+            pointLightPosition_.push_back(position.value_or(Vec3()));
+            hasPointLights_ |= position.has_value();
+        }
+    }
 
     PathRadiance Li(const Ray& cameraRay, double tMin, double tMax, Rng& rng) const override {
         PathRadiance out;
@@ -56,12 +66,20 @@ public:
             // Medium interaction along [tMin, tEnd].
             bool scattered = false, absorbed = false;
             MediumEvent scatter{};
+            MediumAggregate media;
+            Ray local{ray.at(tMin), ray.d};
+            Support support;
             if (scene_.hasMedia()) {
-                MediumAggregate media = scene_.mediaFor(stack);
+                media = scene_.mediaFor(stack);
                 if (media.size()) {
                     bool emissive = media.isEmissive();
-                    Ray local{ray.at(tMin), ray.d};
                     double length = std::isinf(tEnd) ? 1e30 : tEnd - tMin;
+                    if (hasPointLights_) {
+                        support = mediaSupport(media, local, length);
+                        Spectrum L = equiangularPointLight(media, local, support, stack, beta, rng);
+                        if (branch == Branch::Undecided) out.single += L;
+                        else add(L, false);
+                    }
                     sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
                         if (emissive && !e.mp.emission.isBlack()) {
                             Spectrum L = beta * e.mp.emission / e.sigmaMaj;
@@ -104,6 +122,12 @@ public:
                         Spectrum T = shadowTransmittance(p, ds.ls.wi, ds.ls.dist, stack, rng);
                         double lightDensity = ds.pickProb * ds.ls.pdf;
                         double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, mp.scatterPdf(cosTheta));
+                        if (isPointLight(ds.light)) {  // MIS with the equiangular strategy of this segment
+                            double tLocal = scatter.t - tMin;
+                            double pd = distanceDensity(media, local, tLocal);
+                            double pe = equiangularPdf(ds.light, local, support, tLocal);
+                            w = pd / (pd + pe);
+                        }
                         add(beta * f * T * ds.ls.Li * (w / lightDensity), firstVertex);
                     }
                 }
@@ -173,6 +197,89 @@ public:
     }
 
 private:
+    struct Support {
+        double a = 0, b = 0;  ///< first and last t where the segment's media may be non-zero
+    };
+
+    bool isPointLight(int i) const { return i >= 0 && pointLight_[i]; }
+
+    static Support mediaSupport(const Medium& media, const Ray& ray, double length) {
+        Support s{Infinity, 0};
+        media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
+            s.a = std::min(s.a, seg.tMin);
+            s.b = std::max(s.b, seg.tMax);
+            return true;
+        });
+        return s;
+    }
+
+    /// The density MIS assigns to distance sampling at t: sigma_maj(t) exp(-tau_maj(0, t)), the
+    /// tentative-collision density of the free-flight routine. Any deterministic positive function
+    /// keeps the one-sample MIS unbiased (the weights sum to one); this one follows the real density
+    /// closely where the majorant is tight.
+    static double distanceDensity(const Medium& media, const Ray& ray, double t) {
+        double tau = 0, sigma = 0;
+        media.majorants(ray, 0.0, t * (1 + 1e-12) + 1e-300, [&](const MajorantSegment& seg) {
+            double end = std::min(seg.tMax, t);
+            double len = end - seg.tMin;
+            if (len < 0) return false;
+            double x = seg.decay * len;
+            tau += seg.sigmaMaj * len * (x == 0 ? 1.0 : -std::expm1(-x) / x);
+            if (t < seg.tMax || seg.tMax >= t * (1 - 1e-12)) sigma = seg.sigmaMaj * std::exp(-x);
+            return t >= seg.tMax;
+        });
+        return sigma * std::exp(-tau);
+    }
+
+    /// Equiangular density (Kulla and Fajardo 2012) of t in [a, b] for the point light `light`.
+    double equiangularPdf(int light, const Ray& ray, const Support& s, double t) const {
+        if (!(s.b > s.a) || t < s.a || t > s.b) return 0;
+        Vec3 lp = pointLightPosition_[light];
+        double delta = dot(lp - ray.o, ray.d), D = length(lp - ray.at(delta));
+        if (D < 1e-9 * (1 + std::abs(delta))) return std::isinf(s.b) || s.b > 1e29 ? 0.0 : 1 / (s.b - s.a);
+        double thA = std::atan2(s.a - delta, D), thB = std::atan2(s.b - delta, D);
+        return D / ((thB - thA) * (D * D + (t - delta) * (t - delta)));
+    }
+
+    /// The equiangular strategy: one point light picked by power, one distance along the segment,
+    /// camera-side transmittance by ratio tracking, MIS weight against distance sampling.
+    Spectrum equiangularPointLight(const Medium& media, const Ray& ray, const Support& s, const MediumStack& stack,
+                                   const Spectrum& beta, Rng& rng) const {
+        double pick;
+        size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
+        double u = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        if (!isPointLight(static_cast<int>(li)) || !(s.b > s.a)) return {};
+        Vec3 lp = pointLightPosition_[li];
+        double delta = dot(lp - ray.o, ray.d), D = length(lp - ray.at(delta));
+        double t;
+        if (D < 1e-9 * (1 + std::abs(delta))) {
+            if (s.b > 1e29) return {};
+            t = s.a + u * (s.b - s.a);
+        } else {
+            double thA = std::atan2(s.a - delta, D), thB = std::atan2(s.b - delta, D);
+            t = delta + D * std::tan(thA + u * (thB - thA));
+        }
+        double pe = equiangularPdf(static_cast<int>(li), ray, s, t);
+        if (!(pe > 0) || !std::isfinite(t)) return {};
+        Vec3 p = ray.at(t);
+        MediumProperties mp = media.properties(p);
+        if (mp.sigma_s.isBlack()) return {};
+        LightSample ls = scene_.lights()[li]->sample(p, u1, u2);
+        if (!(ls.pdf > 0) || ls.Li.isBlack()) return {};
+        Spectrum f = mp.scatterKernel(dot(ray.d, ls.wi));
+        if (f.isBlack()) return {};
+        Spectrum Tcam = transmittance(media, ray, t, rng, transmittance_);
+        if (Tcam.isBlack()) return {};
+        Spectrum Tsh = shadowTransmittance(p, ls.wi, ls.dist, stack, rng);
+        double pd = distanceDensity(media, ray, t);
+        double w = pe / (pe + pd);
+        return beta * Tcam * f * Tsh * ls.Li * (w / (pick * ls.pdf * pe));
+    }
+
+    std::vector<bool> pointLight_;
+    std::vector<Vec3> pointLightPosition_;
+    bool hasPointLights_ = false;
+
     bool roulette(Spectrum& beta, int depth, Rng& rng) const {
         if (depth < settings_.rouletteDepth) return true;
         double q = std::max(0.0, 1 - beta.maxValue());

@@ -44,7 +44,7 @@ public:
         step_ = settings.marchStep > 0 ? settings.marchStep : diameter / 256;
         std::vector<double> extended, point;
         for (const LightPtr& l : scene.lights()) {
-            bool isPoint = l->isDelta() && l->describe() != "distant";
+            bool isPoint = l->pointPosition().has_value();
             double p = l->power(scene.radius()).average();
             extended.push_back(isPoint ? 0.0 : p);
             if (isPoint) pointLights_.push_back(static_cast<int>(&l - &scene.lights()[0]));
@@ -259,8 +259,7 @@ private:
                          const MediumStack& stack, Rng& rng) const {
         if (!(b > a)) return {};
         const Light& L = *scene_.lights()[light];
-        LightSample probe = L.sample(ray.o, 0.5, 0.5);
-        Vec3 lp = ray.o + probe.wi * probe.dist;
+        Vec3 lp = *L.pointPosition();
         double delta = dot(lp - ray.o, ray.d);
         double D = length(lp - ray.at(delta));
         double t, pdf;

@@ -1,0 +1,159 @@
+// Heterogeneous medium over OpenVDB float grids (density, and optionally temperature, emission and
+// albedo fields), sampled with trilinear interpolation, with a coarse majorant grid for free flights.
+//
+// | parameter        | type     | default   | units            | meaning                                        |
+// |------------------|----------|-----------|------------------|------------------------------------------------|
+// | filePath         | string   |           |                  | .vdb file (loadGridMedium only)                |
+// | densityGrid      | string   | "density" |                  | FloatGrid of relative density (>= 0)           |
+// | temperatureGrid  | string   | ""        |                  | FloatGrid of temperature units; "" = none      |
+// | emissionGrid     | string   | ""        |                  | FloatGrid scaling `emission`; "" = none        |
+// | albedoGrid       | string   | ""        |                  | FloatGrid scaling `albedo` (clamped to [0,1])  |
+// | densityScale     | double   | 1         | 1/scene unit     | sigma_t = densityScale*density(x)*extinctionColor |
+// | extinctionColor  | Spectrum | (1,1,1)   |                  | per-channel extinction multiplier (>= 0)       |
+// | albedo           | Spectrum | (0.8,...) |                  | sigma_s / sigma_t, each in [0, 1]              |
+// | emission         | Spectrum | 0         | radiance/unit    | emitted radiance per unit length               |
+// | emissionScale    | double   | 1         |                  | multiplies `emission` and blackbody emission   |
+// | temperatureScale | double   | 1         | K per grid unit  | T = temperatureScale * temperature(x)          |
+// | phase            | PhasePtr | isotropic |                  | phase function                                 |
+// | objectToWorld    | Affine   | identity  |                  | grid world (object) space -> render world space|
+//
+// Coefficients at a world point x (all grids sampled trilinearly in their own index space):
+//   sigma_t(x)  = densityScale * density(x) * extinctionColor
+//   sigma_s(x)  = sigma_t(x) * clamp(albedo * albedoGrid(x), 0, 1)          (albedoGrid = 1 if unbound)
+//   sigma_a(x)  = sigma_t(x) - sigma_s(x)
+//   emission(x) = emissionScale * emission * emissionGrid(x)                 (emissionGrid = 1 if unbound)
+//               + emissionScale * sigma_a(x) * blackbodyRadiance(temperatureScale * temperature(x))
+// Every coefficient, emission included, is 0 where the interpolated density is 0: the free-flight
+// sampler only visits points inside majorant segments, which cover exactly where density may be
+// non-zero, so emission elsewhere could never be gathered. The blackbody term follows Kirchhoff's
+// law (emission coefficient = absorption coefficient * blackbody radiance), as in pbrt-v4.
+//
+// The medium's support is the density grid's active voxel bounding box dilated by one voxel (the
+// reach of trilinear interpolation); a non-zero background value applies inside it only.
+// NaN, infinite and negative values of every grid are clamped to 0 at load, with one warning per grid.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <openvdb/version.h>  // light: only the version namespace macros
+
+#include "core/medium.h"
+
+namespace openvdb {
+OPENVDB_USE_VERSION_NAMESPACE
+namespace OPENVDB_VERSION_NAME {
+class GridBase;
+}
+}  // namespace openvdb
+
+namespace volphoton {
+
+class MajorantGrid;
+
+/// Parameters of a grid medium (the schema's VolPhotonMediumAPI plus the bound field names).
+struct GridMediumDesc {
+    std::string filePath;
+    std::string densityGrid = "density";
+    std::string temperatureGrid;  ///< "" = no temperature field (no blackbody emission)
+    std::string emissionGrid;     ///< "" = no emission field
+    std::string albedoGrid;       ///< "" = no albedo field
+    double densityScale = 1.0;
+    Spectrum extinctionColor{1.0, 1.0, 1.0};
+    Spectrum albedo{0.8, 0.8, 0.8};
+    Spectrum emission{0.0, 0.0, 0.0};
+    double emissionScale = 1.0;
+    double temperatureScale = 1.0;
+    PhasePtr phase;  ///< null = isotropic
+    Affine objectToWorld;
+};
+
+/// In-memory grids for the GridMedium constructor; each must be an openvdb::FloatGrid with a linear
+/// transform. Only `density` is required. (A FloatGrid::Ptr converts to these implicitly.)
+struct GridMediumGrids {
+    std::shared_ptr<const openvdb::GridBase> density;
+    std::shared_ptr<const openvdb::GridBase> temperature;
+    std::shared_ptr<const openvdb::GridBase> emission;
+    std::shared_ptr<const openvdb::GridBase> albedo;
+};
+
+/// Chromaticity of a blackbody at `kelvin` as linear Rec.709/sRGB primaries, normalised to luminance
+/// 1: Planck's law integrated against the CIE 1931 2-degree colour matching functions in the
+/// multi-lobe Gaussian fit of Wyman, Sloan and Shirley 2013 ("Simple Analytic Approximations to the
+/// CIE XYZ Color Matching Functions", JCGT 2(2)), then XYZ -> linear sRGB, negative components
+/// clamped to 0. Tabulated at start-up; 0 for kelvin <= 0.
+Spectrum blackbodyColor(double kelvin);
+
+/// Blackbody radiance used for temperature emission (radiance units of the scene):
+///   blackbodyRadiance(T) = blackbodyColor(T) * (T / 1000 K)^4
+/// i.e. luminance follows the Stefan-Boltzmann T^4 law, normalised to 1 at 1000 K:
+/// | T (K)  | luminance |
+/// |--------|-----------|
+/// | 500    | 0.0625    |
+/// | 1000   | 1         |
+/// | 1500   | 5.06      |
+/// | 3000   | 81        |
+/// | 6500   | 1785      |
+/// Multiply by emissionScale (and, in the medium, by sigma_a) to tune brightness.
+Spectrum blackbodyRadiance(double kelvin);
+
+/// \class GridMedium
+/// Immutable after construction; properties() and majorants() are thread-safe.
+class GridMedium final : public Medium {
+public:
+    /// From in-memory grids. The caller's grids are never modified: if a grid needs sanitising
+    /// (NaN/Inf/negative values) the medium keeps a cleaned deep copy. desc.filePath only names the
+    /// source in messages. Throws std::runtime_error on a missing/non-float/non-linear grid or a
+    /// non-invertible transform, std::invalid_argument on invalid scalar parameters.
+    GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids);
+    ~GridMedium() override;
+    GridMedium(const GridMedium&) = delete;
+    GridMedium& operator=(const GridMedium&) = delete;
+
+    MediumProperties properties(const Vec3& p) const override;
+    void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
+    Bounds3 bounds() const override;
+    bool isEmissive() const override;
+    double maxAlbedo() const override;
+    std::string describe() const override;
+
+    /// Largest density grid value (after sanitising; before densityScale).
+    double maxDensity() const;
+    /// Support in the density grid's index space: active voxel bbox dilated by one voxel
+    /// (voxel centres at integer coordinates). Empty when the grid has no active values.
+    Bounds3 indexBounds() const;
+    /// Active voxels of the density grid, active tiles counted by the voxels they cover.
+    size_t activeVoxelCount() const;
+    /// Interpolated density grid value at a world point (before densityScale); 0 outside the support.
+    double density(const Vec3& p) const;
+    /// The majorant grid over indexBounds() (cell values are density grid maxima, unscaled).
+    const MajorantGrid& majorantGrid() const;
+    /// Wall-clock seconds spent building the majorant grid (statistics).
+    double majorantBuildSeconds() const;
+    /// Render world <-> density index space (density grid transform composed with objectToWorld).
+    const Affine& worldToIndex() const;
+    const Affine& indexToWorld() const;
+
+private:
+    struct Impl;
+    GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids, bool gridsOwned);
+    friend std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc);
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Opens desc.filePath, reads the named grids and builds the medium. Throws std::runtime_error naming
+/// the file and grid on a missing, unreadable or corrupt file, a grid name not in the file (the
+/// message lists the grids that are there), a grid that is not a FloatGrid (naming its type), a
+/// frustum (non-linear) grid transform, or a non-finite / non-invertible objectToWorld.
+std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc);
+
+/// Writes a deterministic procedural cloud as a FloatGrid named "density" to `path`: a smooth
+/// fractal value-noise blob inside a sphere of radius 0.45 * resolution voxels centred in a
+/// resolution^3 box with its index-space origin at the corner, values in [0, 1], 0 (inactive) outside
+/// the blob, voxel size `voxelSize` scene units. The same (resolution, voxelSize, seed) gives the
+/// same file contents on every run. Throws std::invalid_argument on resolution < 1 or voxelSize <= 0
+/// and std::runtime_error when the file cannot be written.
+void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed);
+
+}  // namespace volphoton
