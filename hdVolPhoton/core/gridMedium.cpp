@@ -377,8 +377,8 @@ double gridMaxValue(const FloatTree& tree) {
     return m;
 }
 
-void checkScalar(double v, const char* name, bool allowZero = true) {
-    if (!std::isfinite(v) || v < 0 || (!allowZero && v == 0))
+void checkScalar(double v, const char* name) {
+    if (!std::isfinite(v) || v < 0)
         throw std::invalid_argument(std::string("grid medium: ") + name + " must be finite and >= 0");
 }
 void checkSpectrum(const Spectrum& s, const char* name) {
@@ -862,7 +862,7 @@ void writeProceduralCloudVdb(const std::string& path, int resolution, double vox
                         double r2 = ux * ux + uy * uy + uz * uz;
                         if (r2 >= 1) continue;
                         double n = fractalNoise(noiseSeed, 2.5 * ux + 17.0, 2.5 * uy + 31.0, 2.5 * uz + 47.0);
-                        double d = (1.0 - r2) * (0.55 + 1.1 * n) * 2.0 - 0.1;
+                        double d = (1.0 - r2) * (0.45 + 1.2 * n) * 1.4 - 0.08;
                         if (d <= 0) continue;
                         acc.setValue(Coord(i, j, k), static_cast<float>(std::min(d, 1.0)));
                     }

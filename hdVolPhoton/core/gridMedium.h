@@ -112,13 +112,17 @@ public:
     GridMedium& operator=(const GridMedium&) = delete;
 
     MediumProperties properties(const Vec3& p) const override;
+    /// Walks the majorant grid in index space: one segment per run of crossed cells with equal
+    /// maximum, sigmaMaj = cellMax * densityScale * extinctionColor.maxValue() * (1 + 1e-9) (the
+    /// factor absorbs interpolation rounding), decay 0. Empty cells give gaps.
     void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
     Bounds3 bounds() const override;
     bool isEmissive() const override;
     double maxAlbedo() const override;
     std::string describe() const override;
 
-    /// Largest density grid value (after sanitising; before densityScale).
+    /// Largest density grid value within reach of the support, background included (after
+    /// sanitising; before densityScale): majorantGrid().maxValue().
     double maxDensity() const;
     /// Support in the density grid's index space: active voxel bbox dilated by one voxel
     /// (voxel centres at integer coordinates). Empty when the grid has no active values.
@@ -152,7 +156,8 @@ std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc);
 /// fractal value-noise blob inside a sphere of radius 0.45 * resolution voxels centred in a
 /// resolution^3 box with its index-space origin at the corner, values in [0, 1], 0 (inactive) outside
 /// the blob, voxel size `voxelSize` scene units. The same (resolution, voxelSize, seed) gives the
-/// same file contents on every run. Throws std::invalid_argument on resolution < 1 or voxelSize <= 0
+/// same voxels on every run, whatever the thread count (the file's bytes differ only in the UUID
+/// OpenVDB stamps into every file). Throws std::invalid_argument on resolution < 1 or voxelSize <= 0
 /// and std::runtime_error when the file cannot be written.
 void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed);
 

@@ -58,6 +58,7 @@ public:
         if (v > c) c = v;
     }
     /// Thread-safe raise(): several threads may call it at once (and nothing else meanwhile).
+    /// Implemented with the GCC/Clang __atomic builtins on the float cell.
     void raiseAtomic(int x, int y, int z, float v);
     /// Raises every cell overlapping the closed local-space box b (clipped to the grid) to >= v.
     void raiseBox(const Bounds3& b, float v);

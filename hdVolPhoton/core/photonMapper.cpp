@@ -7,7 +7,9 @@
 //  - Multiple scattering: photons leave the lights in proportion to power, fly through the core's
 //    free-flight routine with spectral tracking (for grey media that is d = -ln(xi)/sigma_t with
 //    absorption by Russian roulette on the albedo), and are stored at volume scattering events once
-//    they have scattered or bounced before (the first event from direct light is the single pass's).
+//    they have scattered, bounced or met a dielectric before (the first event of light arriving in a
+//    straight line is the single pass's; its shadow rays stop at dielectrics, so light refracted into
+//    a translucent object is all in the photon map).
 //    Camera segments gather them with the beam radiance estimate (photonMap.h); the radius shrinks
 //    per pass as r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1) (Knaus and Zwicker 2011, 2D kernel), so the
 //    average over passes converges.
@@ -399,6 +401,9 @@ private:
                 if (rng.uniform() >= q) return;
                 flux *= s.weight / q;
             } else {
+                // The single-scattering pass cannot see through or via a dielectric (its shadow rays
+                // stop there), so events after a specular interaction belong to the photon map.
+                ++events;
                 flux *= s.weight;
             }
             ray = s.next;
@@ -427,7 +432,9 @@ private:
         uint64_t traced = 0;
         double energy[2] = {0, 0};
         tracePhotons(-1, 4096, &pilot, &traced, energy, {});
-        stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : 0.0;
+        // No first events but stored ones (light reaching the medium only through a dielectric or a
+        // bounce) means everything is the photon map's: an infinite ratio.
+        stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : (energy[1] > 0 ? Infinity : 0.0);
         if (energy[0] == 0 && energy[1] == 0) {
             stats.passesSkipped.push_back("multiple scattering (photons): no pilot photon scattered in a medium");
             return;

@@ -1,0 +1,259 @@
+// Scene, lights, cameras and surfaces: sampling consistency of every light, dielectric energy
+// conservation, instancing, nested media, the camera inside a closed medium.
+#include <gtest/gtest.h>
+
+#include "core/homogeneousMedium.h"
+#include "core/integratorBase.h"
+#include "tests/testUtil.h"
+
+using namespace volphoton;
+using volphoton::test::meanAndError;
+
+namespace {
+MeshDesc sphereMesh(const std::string& name, double radius, int n = 48) {
+    MeshDesc m;
+    m.name = name;
+    for (int i = 0; i <= n; ++i)
+        for (int j = 0; j < 2 * n; ++j) {
+            double th = Pi * i / n, ph = Pi * j / n;
+            m.points.push_back(Vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)) * radius);
+        }
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < 2 * n; ++j) {
+            uint32_t a = i * 2 * n + j, b = i * 2 * n + (j + 1) % (2 * n), c = a + 2 * n, d = b + 2 * n;
+            m.indices.insert(m.indices.end(), {a, c, b, b, c, d});
+        }
+    return m;
+}
+
+Affine lookAtCamera(const Vec3& eye) {  // looking at the origin along -Z from +Z
+    return Affine::translate(eye);
+}
+}  // namespace
+
+TEST(SceneLights, LightSamplingMatchesHitQueriesForEveryLightWithExtent) {
+    // Irradiance-like integral of Le over directions from a point, two ways: by the light's own
+    // sampler (Li / pdf) and by uniform sphere directions hitting it (Le / (1/4pi)). Also the pdf
+    // returned by intersect() equals the sample's pdf for the same direction.
+    Affine rectXf = Affine::translate(Vec3(0, 2, 0));
+    rectXf.m[1][1] = 0; rectXf.m[1][2] = 1; rectXf.m[2][1] = -1; rectXf.m[2][2] = 0;  // -Z -> -Y (facing down)
+    std::vector<std::pair<std::string, LightPtr>> lights = {
+        {"sphere", makeSphereLight(Vec3(0.5, 2, 0.3), 0.4, Spectrum(3.0))},
+        {"rect", makeRectLight(rectXf, 1.0, 0.5, Spectrum(2.0))},
+        {"disk", makeDiskLight(rectXf, 0.6, Spectrum(2.0))},
+        {"distant-cone", makeDistantLight(Vec3(0, -1, 0), 0.2, Spectrum(1.5))},
+        {"dome", makeDomeLight(Spectrum(0.7))},
+    };
+    LatLongImage img;
+    img.width = 16;
+    img.height = 8;
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x) img.rgb.insert(img.rgb.end(), {float(1 + x), float(1 + y), float(0.5 + (x * y) % 3)});
+    lights.push_back({"dome-texture", makeDomeLight(Spectrum(1.0), img)});
+    Vec3 ref(0.1, 0.0, -0.2);
+    for (auto& [name, light] : lights) {
+        Rng rng(5);
+        double viaSample = 0, viaHits = 0, hits2 = 0, sample2 = 0;
+        const int n = 400000;
+        for (int i = 0; i < n; ++i) {
+            LightSample ls = light->sample(ref, rng.uniform(), rng.uniform());
+            if (ls.pdf > 0) {
+                viaSample += ls.Li[0] / ls.pdf / n;
+                sample2 += (ls.Li[0] / ls.pdf) * (ls.Li[0] / ls.pdf) / n;
+                double t, pdf;
+                Spectrum Le;
+                ASSERT_TRUE(light->intersect({ref, ls.wi}, Infinity, &t, &Le, &pdf)) << name;
+                EXPECT_NEAR(pdf / ls.pdf, 1.0, 1e-6) << name;
+            }
+            Vec3 w = uniformSphere(rng.uniform(), rng.uniform());
+            double t, pdf;
+            Spectrum Le;
+            if (light->intersect({ref, w}, Infinity, &t, &Le, &pdf)) {
+                viaHits += Le[0] * 4 * Pi / n;
+                hits2 += (Le[0] * 4 * Pi) * (Le[0] * 4 * Pi) / n;
+            }
+        }
+        // 4 standard errors of the difference of the two independent estimates.
+        double se = std::sqrt((hits2 - viaHits * viaHits) / n + (sample2 - viaSample * viaSample) / n);
+        EXPECT_NEAR(viaSample, viaHits, 4 * se) << name;
+        EXPECT_LT(se, 0.03 * viaHits) << name;
+    }
+}
+
+TEST(SceneLights, PhotonEmissionCarriesThePower) {
+    // Mean photon flux equals power() for lights whose photons all leave (no scene clipping).
+    for (auto light : {makeSphereLight(Vec3(0, 0, 0), 0.0, Spectrum(2.0)), makeSphereLight(Vec3(1, 0, 0), 0.5, Spectrum(1.5)),
+                       makeDiskLight(Affine(), 0.5, Spectrum(1.0))}) {
+        Rng rng(2);
+        double sum = 0;
+        const int n = 100000;
+        for (int i = 0; i < n; ++i) {
+            double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+            sum += light->emitPhoton(Vec3(), 10, u).flux[0] / n;
+        }
+        EXPECT_NEAR(sum / light->power(10)[0], 1.0, 1e-6) << light->describe();
+    }
+}
+
+TEST(SceneLights, SpotFalloff) {
+    EXPECT_EQ(spotFalloff(1.0, 0.5, 0.2), 1.0);
+    EXPECT_EQ(spotFalloff(std::cos(0.6), 0.5, 0.2), 0.0);
+    double mid = spotFalloff(std::cos(0.45), 0.5, 0.2);
+    EXPECT_GT(mid, 0.0);
+    EXPECT_LT(mid, 1.0);
+}
+
+TEST(SceneCamera, PerspectiveOrthographicAndDepthOfField) {
+    CameraDesc d;
+    d.cameraToWorld = Affine::translate(Vec3(0, 0, 5));
+    d.tanHalfFovX = 0.5;
+    Camera cam(d, 100, 50);
+    double tMin, tMax;
+    Ray c = cam.generateRay(50, 25, 0.5, 0.5, &tMin, &tMax);
+    EXPECT_NEAR(c.d.z, -1, 1e-12);
+    Ray right = cam.generateRay(100, 25, 0.5, 0.5, &tMin, &tMax);
+    EXPECT_NEAR(right.d.x / -right.d.z, 0.5, 1e-12);
+    Ray top = cam.generateRay(50, 0, 0.5, 0.5, &tMin, &tMax);
+    EXPECT_NEAR(top.d.y / -top.d.z, 0.25, 1e-12);  // aspect 2:1
+    d.projection = CameraDesc::Projection::Orthographic;
+    d.orthoWidth = 4;
+    Camera ortho(d, 100, 50);
+    Ray o = ortho.generateRay(100, 25, 0.5, 0.5, &tMin, &tMax);
+    EXPECT_NEAR(o.o.x, 2, 1e-12);
+    EXPECT_NEAR(o.d.z, -1, 1e-12);
+    // Thin lens: every lens sample's ray passes through the same point on the focus plane.
+    d.projection = CameraDesc::Projection::Perspective;
+    d.lensRadius = 0.1;
+    d.focusDistance = 3;
+    Camera dof(d, 100, 50);
+    for (double u : {0.1, 0.5, 0.9}) {
+        Ray r = dof.generateRay(70, 20, u, 1 - u, &tMin, &tMax);
+        double t = (5 - 3 - r.o.z) / r.d.z;
+        Ray ref = dof.generateRay(70, 20, 0, 0, &tMin, &tMax);
+        double tr = (5 - 3 - ref.o.z) / ref.d.z;
+        EXPECT_NEAR(length(r.at(t) - ref.at(tr)), 0, 1e-9);
+    }
+    d.cameraToWorld.m[0][0] = 0;  // singular
+    EXPECT_THROW(Camera(d, 10, 10), std::invalid_argument);
+}
+
+namespace {
+/// Mean over a small image, per seed.
+test::MeanAndError furnaceMean(const SceneDesc& d, RenderSettings::Integrator integrator, int spp = 16) {
+    auto scene = std::make_shared<Scene>(d);
+    std::vector<double> xs;
+    for (int seed = 0; seed < 16; ++seed) {
+        RenderSettings s;
+        s.integrator = integrator;
+        s.width = s.height = 8;
+        s.samplesPerPixel = spp;
+        s.seed = seed;
+        s.maxDepth = 1000;
+        s.photonsPerPass = 8000;
+        s.initialRadius = 0.1;
+        Renderer r(scene, s);
+        r.render();
+        auto v = r.film().resolveRgb(Film::Beauty);
+        double sum = 0;
+        for (size_t i = 0; i < v.size(); i += 3) sum += v[i];
+        xs.push_back(sum / (v.size() / 3));
+    }
+    return meanAndError(xs);
+}
+}  // namespace
+
+TEST(SceneSurfaces, DielectricSpheresDisappearInAFurnace) {
+    // Glass (no medium) and a non-absorbing translucent object (albedo-1 medium behind an ior 1.5
+    // boundary) in a uniform dome: Fresnel both ways, total internal reflection and the 1/eta^2
+    // radiance scaling must cancel, so every pixel equals the dome.
+    for (bool withMedium : {false, true}) {
+        SceneDesc d;
+        d.meshes.push_back(sphereMesh("ball", 1.0));
+        d.meshes[0].material.kind = SurfaceMaterial::Kind::Dielectric;
+        d.meshes[0].material.ior = 1.5;
+        if (withMedium) {
+            d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(3.0, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), makeHenyeyGreensteinPhase(0.5))));
+            d.meshes[0].interiorMedium = 0;
+        }
+        d.instances.push_back({0, Affine()});
+        d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+        d.camera.cameraToWorld = lookAtCamera(Vec3(0, 0, 3.5));
+        d.camera.tanHalfFovX = 0.3;
+        auto pt = furnaceMean(d, RenderSettings::Integrator::PathTracer);
+        EXPECT_NEAR(pt.mean, 1.0, 4 * pt.stderr_ + 1e-3) << "path tracer, medium " << withMedium;  // 1e-3: tessellation
+        auto pm = furnaceMean(d, RenderSettings::Integrator::PhotonMap, 4);
+        EXPECT_NEAR(pm.mean, 1.0, 4 * pm.stderr_ + 0.03) << "photon map, medium " << withMedium;  // + kernel bias at the boundary
+    }
+}
+
+TEST(SceneSurfaces, LambertianFloorUnderDistantLight) {
+    // A large white floor (albedo a) under a delta distant light of irradiance E at normal incidence,
+    // seen from above with nothing else: radiance a E / pi everywhere.
+    SceneDesc d;
+    MeshDesc floor;
+    floor.points = {Vec3(-100, 0, -100), Vec3(100, 0, -100), Vec3(100, 0, 100), Vec3(-100, 0, 100)};
+    floor.indices = {0, 2, 1, 0, 3, 2};
+    floor.material.albedo = Spectrum(0.6);
+    d.meshes.push_back(floor);
+    d.instances.push_back({0, Affine()});
+    d.lights.push_back(makeDistantLight(Vec3(0, -1, 0), 0.0, Spectrum(Pi)));
+    Affine down = Affine::translate(Vec3(0, 3, 0));
+    down.m[1][1] = 0; down.m[1][2] = 1; down.m[2][1] = -1; down.m[2][2] = 0;  // camera -Z -> world -Y
+    d.camera.cameraToWorld = down;
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        auto m = furnaceMean(d, integrator, 2);
+        EXPECT_NEAR(m.mean, 0.6, 1e-6);  // deterministic up to the film's float rounding
+    }
+}
+
+TEST(SceneInstancing, InstancesShareAMeshAndBadTransformsAreSkipped) {
+    SceneDesc d;
+    d.meshes.push_back(sphereMesh("ball", 0.5, 8));
+    d.instances.push_back({0, Affine::translate(Vec3(-2, 0, 0))});
+    d.instances.push_back({0, Affine::translate(Vec3(2, 0, 0))});
+    Affine singular = Affine::scale(Vec3(1, 0, 1));
+    d.instances.push_back({0, singular});
+    Scene scene(d);
+    SurfaceHit hit;
+    EXPECT_TRUE(scene.intersect({Vec3(-2, 0, 5), Vec3(0, 0, -1)}, 0, Infinity, &hit));
+    EXPECT_EQ(hit.instance, 0);
+    EXPECT_NEAR(hit.t, 4.5, 1e-3);
+    EXPECT_TRUE(scene.intersect({Vec3(2, 0, 5), Vec3(0, 0, -1)}, 0, Infinity, &hit));
+    EXPECT_EQ(hit.instance, 1);
+    EXPECT_NEAR(std::abs(hit.ng.z), 1.0, 0.05);  // a coarse 8x16 tessellation: facets tilt by up to ~16 degrees
+    EXPECT_FALSE(scene.intersect({Vec3(0, 0, 5), Vec3(0, 0, -1)}, 0, Infinity, &hit));  // the singular one is skipped
+}
+
+TEST(SceneMedia, NestedMediaAndCameraInsideAClosedMesh) {
+    SceneDesc d;
+    d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(0.5, Spectrum(1.0), Spectrum(0.5), Spectrum(0.0), makeIsotropicPhase())));
+    d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(4.0, Spectrum(1.0), Spectrum(0.5), Spectrum(0.0), makeIsotropicPhase())));
+    d.meshes.push_back(sphereMesh("outer", 3.0));
+    d.meshes.push_back(sphereMesh("inner", 1.0));
+    for (int i = 0; i < 2; ++i) {
+        d.meshes[i].material.kind = SurfaceMaterial::Kind::Boundary;
+        d.meshes[i].interiorMedium = i;
+        d.instances.push_back({i, Affine()});
+    }
+    Scene scene(d);
+    MediumStack atCenter = scene.stackAt(Vec3(0.1, 0.05, 0));
+    ASSERT_EQ(atCenter.size, 2);
+    EXPECT_EQ(atCenter.innermost(), 1);
+    EXPECT_EQ(scene.stackAt(Vec3(2, 0, 0)).innermost(), 0);
+    EXPECT_EQ(scene.stackAt(Vec3(5, 0, 0)).size, 0);
+    // The inner medium replaces the outer one: one member in the aggregate, sigma_t 4.
+    MediumAggregate m = scene.mediaFor(atCenter);
+    EXPECT_EQ(m.size(), 1);
+    EXPECT_DOUBLE_EQ(m.properties(Vec3()).sigma_t()[0], 4.0);
+    // Transmittance from the centre to outside: exp(-(4 * 1 + 0.5 * 2)) through both boundaries.
+    RenderSettings s;
+    auto pt = makePathTracer(scene, s);
+    struct Probe : Integrator {
+        using Integrator::Integrator;
+        PathRadiance Li(const Ray&, double, double, Rng&) const override { return {}; }
+        Spectrum T(const Vec3& p, const Vec3& w, double dist, MediumStack st, Rng& rng) const { return shadowTransmittance(p, w, dist, st, rng); }
+    } probe(scene, s);
+    Rng rng(1);
+    Spectrum T = probe.T(Vec3(0, 0, 0), Vec3(1, 0, 0), 10, atCenter, rng);
+    EXPECT_NEAR(T[0], std::exp(-5.0), 2e-3);  // tessellated spheres: radii within 0.2%
+}
