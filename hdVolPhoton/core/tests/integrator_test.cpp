@@ -163,7 +163,12 @@ TEST(IntegratorFurnace, VdbMedium) {
         d.camera = lookAt(c, c + Vec3(0, 0, -1));
         return d;
     };
-    expectEveryPixel(renderSeeds(inside, smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0)), 1.0, 5, 0.02, "photon map vdb furnace");
+    RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0);
+    // Forward scattering wants a wide beam (near-normal per-seed means, see above); the cloud's
+    // density gradients want a narrow one (the kernel blurs the source term across the ray).
+    pm.initialRadius = 0.1;
+    pm.photonsPerPass = 16000;
+    expectEveryPixel(renderSeeds(inside, pm), 1.0, 5, 0.02, "photon map vdb furnace");
 }
 
 TEST(IntegratorEmission, EquilibriumWithDome) {
