@@ -59,8 +59,8 @@ public:
             Spectrum lightLe;
             double lightPdf = 0;
             int light = -1;
-            bool hasLight = hitLight(ray, tEnd, &tLight, &lightLe, &lightPdf, &light);
-            if (hasLight && !std::isinf(tLight)) tEnd = tLight;
+            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light);
+            if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
             if (firstSegment && hasHit) out.depth = hit.t;
 
             // Medium interaction along [tMin, tEnd].

@@ -92,8 +92,8 @@ public:
             Spectrum lightLe;
             double lightPdf;
             int light = -1;
-            bool hasLight = hitLight(ray, tEnd, &tLight, &lightLe, &lightPdf, &light);
-            if (hasLight && !std::isinf(tLight)) tEnd = tLight;
+            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light);
+            if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
             if (firstSegment && hasHit) out.depth = hit.t;
 
             Spectrum Tseg(1.0);

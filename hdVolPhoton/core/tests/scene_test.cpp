@@ -257,3 +257,21 @@ TEST(SceneMedia, NestedMediaAndCameraInsideAClosedMesh) {
     Spectrum T = probe.T(Vec3(0, 0, 0), Vec3(1, 0, 0), 10, atCenter, rng);
     EXPECT_NEAR(T[0], std::exp(-5.0), 2e-3);  // tessellated spheres: radii within 0.2%
 }
+
+TEST(SceneCamera, FarClipHidesGeometryNotTheEnvironment) {
+    // USD cameras always have a finite far clip; rays that pass it without a hit still see the dome.
+    SceneDesc d;
+    d.meshes.push_back(sphereMesh("ball", 1.0, 16));
+    d.instances.push_back({0, Affine::translate(Vec3(0, 0, -20))});
+    d.lights.push_back(makeDomeLight(Spectrum(0.5)));
+    d.camera.farClip = 10;
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        RenderSettings s;
+        s.integrator = integrator;
+        s.width = s.height = 4;
+        s.samplesPerPixel = 1;
+        Renderer r(std::make_shared<Scene>(d), s);
+        r.render();
+        for (float v : r.film().resolveRgb(Film::Beauty)) EXPECT_FLOAT_EQ(v, 0.5f);
+    }
+}
