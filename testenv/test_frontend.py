@@ -488,8 +488,8 @@ def test_camera_round_trip_and_aperture_conform(tmp_path):
     narrow = usdscene.translate(stage, Usd.TimeCode.Default(), 200, 200, "/cam")
     assert narrow.desc.camera.tan_half_fov_x == pytest.approx(18 / 35)
     ortho = usdscene.translate(stage, Usd.TimeCode.Default(), 200, 100, "/ortho")
-    # the default far plane (1e6) is beyond the scene: infinite, so the dome stays visible
-    assert math.isinf(ortho.desc.camera.far_clip) and ortho.desc.camera.near_clip == pytest.approx(1)
+    # the clipping range is kept as authored (the core shows the dome past the far plane)
+    assert ortho.desc.camera.far_clip == pytest.approx(1e6) and ortho.desc.camera.near_clip == pytest.approx(1)
     assert ortho.desc.camera.projection == _core.CameraDesc.Projection.Orthographic
     assert ortho.desc.camera.ortho_width == pytest.approx(4.0)  # 40 tenths of a unit
     # without cameras: a default framing camera, with a warning

@@ -3,9 +3,11 @@
 // sanitising of invalid voxels and the procedural cloud writer.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
@@ -600,6 +602,49 @@ TEST(GridEmission, BlackbodyColourAndTemperatureEmission) {
     EXPECT_NEAR(m.maxAlbedo(), 0.25, 1e-12);
     desc.temperatureGrid.clear();
     EXPECT_FALSE(GridMedium(desc, GridMediumGrids{dens}).isEmissive());
+}
+
+// ---- concurrency -------------------------------------------------------------------------------
+
+TEST(GridConcurrency, ThreadsAndInterleavedMediaAgreeWithSerialLookups) {
+    // Per-thread accessors are cached per medium: lookups from several threads, alternating
+    // between two media (and one destroyed and replaced), must equal the serial answers exactly.
+    std::string path = tempPath("conc.vdb");
+    writeProceduralCloudVdb(path, 32, 1.0 / 32, 5);
+    GridMediumDesc desc;
+    desc.filePath = path;
+    auto a = loadGridMedium(desc);
+    auto b = std::make_unique<GridMedium>(GridMediumDesc{}, GridMediumGrids{spikyGrid(9)});
+    std::vector<Vec3> pa, pb;
+    Rng rng(17);
+    for (int i = 0; i < 20000; ++i) {
+        pa.push_back(Vec3(rng.uniform(), rng.uniform(), rng.uniform()));
+        pb.push_back(Vec3(60 * rng.uniform(), 50 * rng.uniform(), 40 * rng.uniform()));
+    }
+    std::vector<double> ra, rb;
+    for (int i = 0; i < 20000; ++i) ra.push_back(a->density(pa[i]));
+    for (int i = 0; i < 20000; ++i) rb.push_back(b->density(pb[i]));
+    std::atomic<int> mismatches{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t)
+        threads.emplace_back([&, t] {
+            for (int i = t; i < 20000; i += 2) {
+                if (a->density(pa[i]) != ra[i]) ++mismatches;
+                if (b->density(pb[i]) != rb[i]) ++mismatches;
+            }
+        });
+    for (auto& th : threads) th.join();
+    EXPECT_EQ(mismatches.load(), 0);
+    // Replace b by a different medium: no thread may see the old one's cached nodes.
+    b = std::make_unique<GridMedium>(GridMediumDesc{}, GridMediumGrids{spikyGrid(10)});
+    std::vector<double> rb2;
+    for (int i = 0; i < 20000; ++i) rb2.push_back(b->density(pb[i]));
+    EXPECT_NE(rb2, rb);
+    for (int i = 0; i < 20000; ++i) {
+        ASSERT_EQ(b->density(pb[i]), rb2[i]);
+        ASSERT_EQ(a->density(pa[i]), ra[i]);
+    }
+    std::remove(path.c_str());
 }
 
 // ---- procedural cloud ----------------------------------------------------------------------------

@@ -85,9 +85,8 @@ Camera (UsdGeomCamera; apertures and focal length in tenths of a scene unit)
       expandAperture; adjustApertureWidth, adjustApertureHeight, cropAperture also supported).
     * orthographic: orthoWidth = horizontalAperture' / 10 scene units.
     * depth of field: fStop > 0 -> lensRadius = (focalLength / 10) / (2 fStop) scene units,
-      focusDistance in scene units; clippingRange -> near/far, except that a far plane beyond the
-      whole scene (bounds of geometry and bounded media) becomes infinite: the core shows distant
-      and dome lights only to rays that are not clipped.  Aperture offsets: warning.
+      focusDistance in scene units; clippingRange -> near/far (the far plane clips geometry and media;
+      rays that pass it still see distant and dome lights).  Aperture offsets: warning.
     * no camera: a default camera looking at the stage's bounds (warning).
 """
 
@@ -1351,17 +1350,6 @@ def _camera(prim: Usd.Prim, time, xf: UsdGeom.XformCache, width: int, height: in
     if not (0 <= near < far):
         d.error(path, "clippingRange", "clippingRange %s is not 0 <= near < far; ignored" % ((near, far),))
         near, far = 0.0, math.inf
-    # The core only lets rays that reach t = inf see distant and dome lights, so a far plane beyond
-    # everything in the scene becomes infinite (same geometry, and the environment stays visible).
-    if bounds is None and math.isfinite(far):
-        far = math.inf  # nothing to clip
-    elif bounds is not None and math.isfinite(far):
-        eye = world[:3, 3]
-        lo, hi = np.array(bounds[0]), np.array(bounds[1])
-        farthest = float(np.linalg.norm(np.maximum(np.abs(lo - eye), np.abs(hi - eye))))
-        scale = float(np.linalg.norm(world[:3, 2])) or 1.0
-        if far * scale >= farthest:
-            far = math.inf
     desc.near_clip, desc.far_clip = near, far
     if fstop > 0 and projection == "perspective":
         if not (focus > 0 and math.isfinite(focus)):
