@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <openvdb/version.h>  // light: only the version namespace macros
 
@@ -72,6 +73,12 @@ struct GridMediumDesc {
 /// In-memory grids for the GridMedium constructor; each must be an openvdb::FloatGrid with a linear
 /// transform. Only `density` is required. (A FloatGrid::Ptr converts to these implicitly.)
 struct GridMediumGrids {
+    using GridPtr = std::shared_ptr<const openvdb::GridBase>;
+    GridMediumGrids() = default;
+    GridMediumGrids(GridPtr density_, GridPtr temperature_ = nullptr, GridPtr emission_ = nullptr,
+                    GridPtr albedo_ = nullptr)
+        : density(std::move(density_)), temperature(std::move(temperature_)), emission(std::move(emission_)),
+          albedo(std::move(albedo_)) {}
     std::shared_ptr<const openvdb::GridBase> density;
     std::shared_ptr<const openvdb::GridBase> temperature;
     std::shared_ptr<const openvdb::GridBase> emission;

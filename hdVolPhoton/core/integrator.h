@@ -21,6 +21,9 @@
 // | multipleThreshold   | double | 1e-3       |              | photonMap: skip photons when a pilot estimates the|
 // |                     |        |            |              | multiple/single energy ratio below this           |
 // | transmittanceCutoff | double | 0          |              | deterministic early termination (BIASED)          |
+// | photonMapBudgetBytes| size_t | 1 GiB      | bytes        | photonMap: memory cap of one pass's photon map;   |
+// |                     |        |            |              | beyond it photons are thinned at random, their    |
+// |                     |        |            |              | power scaled up (unbiased), and the stats say so  |
 //
 // AOVs: the light-path split is decided by the first vertex of the camera path other than an
 // index-matched medium boundary:
@@ -62,6 +65,7 @@ struct RenderSettings {
     bool multipleScattering = true;
     double multipleThreshold = 1e-3;
     double transmittanceCutoff = 0;
+    size_t photonMapBudgetBytes = size_t(1) << 30;
 };
 
 /// What ran, what was skipped and why, and how long each part took.
@@ -74,6 +78,7 @@ struct RenderStats {
     double photonRadius = 0;
     double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
     size_t photonMapBytes = 0;
+    uint64_t photonsThinned = 0;  ///< photons dropped to stay within photonMapBudgetBytes
     std::vector<std::string> passesRun;
     std::vector<std::string> passesSkipped;  ///< "name: reason"
     bool cancelled = false;

@@ -38,7 +38,10 @@ public:
     void query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const Photon&, double, double)> visit) const;
     double radius() const { return radius_; }
     size_t size() const { return photons_.size(); }
-    size_t bytes() const { return photons_.capacity() * sizeof(Photon) + photons_.size() * 16 * 2; }
+    size_t bytes() const { return photons_.size() * BytesPerPhoton; }
+    /// Approximate memory per stored photon: the record, its disc in Embree's vertex buffer (16 bytes)
+    /// and a share of the BVH over it (an estimate of 32 bytes for Embree 3 point geometry).
+    static constexpr size_t BytesPerPhoton = sizeof(Photon) + 16 + 32;
 
 private:
     std::vector<Photon> photons_;

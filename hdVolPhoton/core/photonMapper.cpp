@@ -66,6 +66,7 @@ public:
         std::vector<Photon> photons;
         uint64_t traced = 0;
         if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel)) return false;
+        stats.photonsThinned += thinToBudget(pass, &photons);
         map_ = std::make_unique<PhotonMap>(std::move(photons), r);
         stats.photonsTraced += traced;
         stats.photonsStored += map_->size();
@@ -408,6 +409,30 @@ private:
             }
             ray = s.next;
         }
+    }
+
+    /// Keeps the photon map within the memory budget: each photon survives with probability
+    /// p = budget / size and its power is divided by p, so the estimate stays unbiased.
+    uint64_t thinToBudget(int pass, std::vector<Photon>* photons) const {
+        size_t maxPhotons = std::max<size_t>(1, settings_.photonMapBudgetBytes / PhotonMap::BytesPerPhoton);
+        if (photons->size() <= maxPhotons) return 0;
+        double p = static_cast<double>(maxPhotons) / photons->size();
+        Rng rng(hashKeys(0x5448494eULL, settings_.seed, pass));
+        size_t kept = 0;
+        for (const Photon& ph : *photons) {
+            if (rng.uniform() >= p) continue;
+            Photon q = ph;
+            for (float& c : q.power) c = static_cast<float>(c / p);
+            (*photons)[kept++] = q;
+        }
+        uint64_t dropped = photons->size() - kept;
+        photons->resize(kept);
+        photons->shrink_to_fit();
+        static std::atomic<bool> warned{false};
+        if (!warned.exchange(true))
+            warn("photon map over its budget of " + std::to_string(settings_.photonMapBudgetBytes >> 20) + " MiB: " +
+                 std::to_string(dropped) + " photons thinned (power rescaled; more noise, no bias)");
+        return dropped;
     }
 
     void decidePasses(RenderStats& stats) {

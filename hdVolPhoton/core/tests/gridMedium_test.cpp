@@ -144,7 +144,9 @@ TEST(GridMajorantWalk, MatchesBruteForceCellLookupAndMergesRuns) {
             if (i > 0) {
                 EXPECT_GE(segs[i].t0, segs[i - 1].t1);
                 // Touching runs must differ in value (equal neighbours are merged).
-                if (segs[i].t0 == segs[i - 1].t1) EXPECT_NE(segs[i].sigmaMaj, segs[i - 1].sigmaMaj);
+                if (segs[i].t0 == segs[i - 1].t1) {
+                    EXPECT_NE(segs[i].sigmaMaj, segs[i - 1].sigmaMaj);
+                }
             }
         }
         // Brute force: the cell under each point must carry the reported value (0 = in no run).
@@ -280,7 +282,9 @@ void checkMajorantsBoundDensity(const GridMedium& medium, uint64_t seed, int ray
             ASSERT_LT(segs[i].t0, segs[i].t1);
             ASSERT_GE(segs[i].t0, tMin);
             ASSERT_LE(segs[i].t1, tMax);
-            if (i) ASSERT_GE(segs[i].t0, segs[i - 1].t1);
+            if (i) {
+                ASSERT_GE(segs[i].t0, segs[i - 1].t1);
+            }
             for (int k = 0; k < 64; ++k) {
                 double t = segs[i].t0 + (segs[i].t1 - segs[i].t0) * rng.uniform();
                 double st = medium.properties(r.at(t)).sigma_t().maxValue();

@@ -492,3 +492,20 @@ TEST(IntegratorPhotonMap, BeamQueryFindsExactlyThePhotonsWithinTheRadius) {
         }
     }
 }
+
+TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
+    // A budget of ~1/10 of the photons: the image mean must stay within noise of the unlimited one.
+    SceneDesc d = mediaOnlyScene();
+    RenderSettings full = smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0);
+    full.photonsPerPass = 20000;
+    full.singleScattering = false;
+    RenderSettings capped = full;
+    capped.photonMapBudgetBytes = 2000 * PhotonMap::BytesPerPhoton;
+    auto a = imageMean(d, full, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    auto b = imageMean(d, capped, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_));
+    Renderer r(std::make_shared<Scene>(d), capped);
+    r.render();
+    EXPECT_GT(r.stats().photonsThinned, 0u);
+    EXPECT_LE(r.stats().photonMapBytes, capped.photonMapBudgetBytes * 2);
+}
