@@ -112,6 +112,7 @@ py::dict statsToDict(const RenderStats& s) {
     d["photon_radius"] = s.photonRadius;
     d["multiple_to_single_ratio"] = s.multipleToSingleRatio;
     d["photon_map_bytes"] = s.photonMapBytes;
+    d["photons_thinned"] = s.photonsThinned;
     d["passes_run"] = s.passesRun;
     d["passes_skipped"] = s.passesSkipped;
     d["cancelled"] = s.cancelled;
@@ -136,6 +137,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["multipleScattering"] = s.multipleScattering;
     d["multipleThreshold"] = s.multipleThreshold;
     d["transmittanceCutoff"] = s.transmittanceCutoff;
+    d["photonMapBudgetBytes"] = s.photonMapBudgetBytes;
     return d;
 }
 
@@ -615,6 +617,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("multiple_scattering", &RenderSettings::multipleScattering)
         .def_readwrite("multiple_threshold", &RenderSettings::multipleThreshold)
         .def_readwrite("transmittance_cutoff", &RenderSettings::transmittanceCutoff)
+        .def_readwrite("photon_map_budget_bytes", &RenderSettings::photonMapBudgetBytes)
         .def("to_dict", &settingsToDict, "Settings under their documented (integrator.h) names")
         .def("__repr__", [](const RenderSettings& s) { return py::repr(settingsToDict(s)).cast<std::string>(); });
 
