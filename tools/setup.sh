@@ -36,4 +36,5 @@ CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)} pip install -
 echo "setup: building the C++ core, its tests and tools in build/"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build
+[ -f testenv/cloud.vdb ] || python tools/make_cloud_vdb.py testenv/cloud.vdb
 echo "setup: done. Activate with: . .venv/bin/activate"
