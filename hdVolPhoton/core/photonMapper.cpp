@@ -21,8 +21,9 @@
 //    doubled weight (Russian roulette, unbiased given the march); `transmittanceCutoff` stops it
 //    outright instead (BIASED).
 //
-// XXX: volume emission is added along camera segments but emissive media emit no photons, so light
-//      scattered from emissive media is missing here; the renderer warns and the path tracer has it.
+//  - Volume emission: along camera segments by the march (the `emission` AOV); emissive media also
+//    emit photons (uniform points in the medium's box, weighted by the local emission) so light they
+//    send into scattering media is in the photon map.
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -56,6 +57,11 @@ public:
         if (hasExtended_) extendedDist_ = Distribution1D(extended);
         hasMeshMedia_ = false;
         for (const MeshDesc& m : scene.desc().meshes) hasMeshMedia_ |= m.material.kind != SurfaceMaterial::Kind::Lambertian;
+        findEmitters();
+        std::vector<double> power;
+        for (const LightPtr& l : scene.lights()) power.push_back(l->power(scene.radius()).average());
+        for (const Emitter& e : emitters_) power.push_back(e.power);
+        if (!power.empty()) sourceDist_ = Distribution1D(power);
     }
 
     bool beginPass(int pass, RenderStats& stats, const CancelCallback& cancel) override {
@@ -301,7 +307,7 @@ private:
     /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
     /// (index 0) and at stored events (index 1).
     bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel) const {
-        if (!lightDist_.size() || count <= 0) return true;
+        if (!sourceDist_.size() || count <= 0) return true;
         int batches = (count + PhotonBatch - 1) / PhotonBatch;
         std::vector<std::vector<Photon>> perBatch(batches);
         std::vector<std::array<double, 2>> perEnergy(batches, {0.0, 0.0});
@@ -321,16 +327,69 @@ private:
         return true;
     }
 
+    /// An emissive medium as a photon source: uniform points in `box` where the medium is present,
+    /// uniform directions. Volume emission is photon-traced so that its scattered light (which the
+    /// single-scattering pass does not compute) is in the photon map.
+    struct Emitter {
+        const Medium* medium;
+        int mesh;  ///< the closed mesh bounding it, or -1 for an unbounded medium
+        Bounds3 box;
+        double volume;
+        double power;  ///< channel-average emitted power, estimated by a deterministic pilot
+    };
+
+    /// Emission source term of an emitter at p (zero outside its mesh).
+    Spectrum emitterSource(const Emitter& e, const Vec3& p) const {
+        if (e.mesh >= 0 && scene_.stackAt(p).innermost() != e.mesh) return {};
+        return e.medium->properties(p).emission;
+    }
+
+    void findEmitters() {
+        Bounds3 sceneBox{scene_.center() - Vec3(1, 1, 1) * scene_.radius(), scene_.center() + Vec3(1, 1, 1) * scene_.radius()};
+        auto add = [&](const Medium* m, int mesh) {
+            if (!m->isEmissive()) return;
+            Bounds3 b = m->bounds(), box;
+            box.lo = vmax(b.lo, sceneBox.lo);
+            box.hi = vmin(b.hi, sceneBox.hi);
+            if (box.empty()) return;
+            Vec3 size = box.hi - box.lo;
+            Emitter e{m, mesh, box, size.x * size.y * size.z, 0.0};
+            Rng rng(hashKeys(0x454d4954ULL, emitters_.size()));
+            const int n = 4096;
+            for (int i = 0; i < n; ++i) {
+                Vec3 p = box.lo + Vec3(size.x * rng.uniform(), size.y * rng.uniform(), size.z * rng.uniform());
+                e.power += emitterSource(e, p).average() * 4 * Pi * e.volume / n;
+            }
+            if (e.power > 0) emitters_.push_back(e);
+        };
+        for (int i : scene_.desc().unboundedMedia) add(scene_.desc().media[i].get(), -1);
+        for (size_t mi = 0; mi < scene_.desc().meshes.size(); ++mi) {
+            const MeshDesc& m = scene_.desc().meshes[mi];
+            if (m.interiorMedium >= 0) add(scene_.desc().media[m.interiorMedium].get(), static_cast<int>(mi));
+        }
+    }
+
     void tracePhoton(Rng& rng, int count, std::vector<Photon>* out, double energy[2]) const {
         double pick;
-        size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
+        size_t source = sourceDist_.sampleDiscrete(rng.uniform(), &pick);
         double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
-        PhotonEmission e = scene_.lights()[li]->emitPhoton(scene_.center(), scene_.radius(), u);
-        Spectrum flux = e.flux / (pick * count);
+        Ray ray;
+        Spectrum flux;
+        int events = 0;  // scatterings, diffuse bounces and dielectric interactions so far
+        if (source < scene_.lights().size()) {
+            PhotonEmission e = scene_.lights()[source]->emitPhoton(scene_.center(), scene_.radius(), u);
+            ray = e.ray;
+            flux = e.flux / (pick * count);
+        } else {
+            const Emitter& em = emitters_[source - scene_.lights().size()];
+            Vec3 size = em.box.hi - em.box.lo;
+            Vec3 p = em.box.lo + Vec3(size.x * u[0], size.y * u[1], size.z * rng.uniform());
+            ray = {p, uniformSphere(u[2], u[3])};
+            flux = emitterSource(em, p) * (4 * Pi * em.volume / (pick * count));
+            events = 1;  // every scattering of emitted light belongs to the photon map
+        }
         if (flux.isBlack() || !flux.isFinite()) return;
-        Ray ray = e.ray;
         MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
-        int events = 0;  // scatterings and diffuse bounces so far
         for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < 256;) {
             SurfaceHit hit;
             bool hasHit = scene_.intersect(ray, 0.0, Infinity, &hit);
@@ -445,10 +504,10 @@ private:
         }
         if (settings_.singleScattering) stats.passesRun.push_back("single scattering");
         else stats.passesSkipped.push_back("single scattering: disabled by settings");
-        if (scene_.hasEmissiveMedia())
-            warn("photonMap integrator: light scattered from emissive media is not traced (XXX); use the pathTracer for emissive scattering media");
+        if (scene_.hasEmissiveMedia() && emitters_.empty())
+            warn("photonMap integrator: the emissive media lie outside the scene's bounds, so their scattered light is not photon-traced");
         if (!settings_.multipleScattering) { stats.passesSkipped.push_back("multiple scattering (photons): disabled by settings"); return; }
-        if (!lightDist_.size() || settings_.photonsPerPass == 0) { stats.passesSkipped.push_back("multiple scattering (photons): no lights or no photons"); return; }
+        if (!sourceDist_.size() || settings_.photonsPerPass == 0) { stats.passesSkipped.push_back("multiple scattering (photons): no lights, no emissive media or no photons"); return; }
         double maxAlbedo = 0;
         for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
         if (maxAlbedo == 0) { stats.passesSkipped.push_back("multiple scattering (photons): every medium has albedo 0"); return; }
@@ -476,6 +535,8 @@ private:
     double radius_, step_;
     std::vector<int> pointLights_;
     Distribution1D extendedDist_;
+    std::vector<Emitter> emitters_;
+    Distribution1D sourceDist_;  ///< lights, then emitters_, by power
     bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false;
     std::unique_ptr<PhotonMap> map_;
 };

@@ -184,6 +184,11 @@ TEST(IntegratorEmission, EquilibriumWithDome) {
         };
         expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PathTracer, 8, 0)), Le, 5, 1e-6,
                          "emission equilibrium, albedo " + std::to_string(albedo));
+        // The photon map: emitted light that scatters comes from emission photons.
+        RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0);
+        pm.photonsPerPass = 8000;
+        pm.initialRadius = 0.2;
+        expectEveryPixel(renderSeeds(make, pm), Le, 5, 0.02 * Le, "photon map emission equilibrium, albedo " + std::to_string(albedo));
     }
 }
 
@@ -508,4 +513,25 @@ TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
     r.render();
     EXPECT_GT(r.stats().photonsThinned, 0u);
     EXPECT_LE(r.stats().photonMapBytes, capped.photonMapBudgetBytes * 2);
+}
+
+TEST(IntegratorAgreement, ScatteringEmissiveMedium) {
+    // An emissive, scattering cloud next to a non-emissive scattering box, no lights: all light is
+    // volume emission, directly seen (emission AOV) or scattered (multiple). Both integrators agree.
+    SceneDesc d;
+    auto glow = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.6), Spectrum(0.8, 0.4, 0.1), makeHenyeyGreensteinPhase(0.2));
+    auto fog = MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+    d.media.push_back(std::make_shared<HomogeneousMedium>(glow, Bounds3{Vec3(-1, -0.5, -0.5), Vec3(0, 0.5, 0.5)}));
+    d.media.push_back(std::make_shared<HomogeneousMedium>(fog, Bounds3{Vec3(0, -0.5, -0.5), Vec3(1, 0.5, 0.5)}));
+    d.unboundedMedia = {0, 1};
+    d.camera = lookAt(Vec3(0.1, 0.2, 3.0), Vec3(0, 0, 0), 0.45);
+    RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 16, 0);
+    RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 8, 0);
+    pm.photonsPerPass = 20000;
+    for (auto aov : {Film::Beauty, Film::Emission, Film::Multiple}) {
+        auto a = imageMean(d, pt, [aov](const Film& f) { return aovMean(f, aov); });
+        auto b = imageMean(d, pm, [aov](const Film& f) { return aovMean(f, aov); });
+        EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_) + 0.02 * a.mean) << "aov " << aov;
+        if (aov == Film::Multiple) EXPECT_GT(a.mean, 0.0);
+    }
 }
