@@ -1,0 +1,101 @@
+#include "hd/mesh.h"
+
+#include "pxr/base/tf/diagnostic.h"
+#include "pxr/imaging/hd/meshUtil.h"
+#include "pxr/imaging/hd/renderIndex.h"
+#include "pxr/imaging/hd/sceneDelegate.h"
+#include "pxr/imaging/hd/tokens.h"
+
+#include "hd/conversions.h"
+#include "hd/instancer.h"
+#include "hd/renderParam.h"
+
+PXR_NAMESPACE_OPEN_SCOPE
+
+HdVolPhotonMesh::HdVolPhotonMesh(SdfPath const &id) : HdMesh(id) {}
+
+HdDirtyBits HdVolPhotonMesh::GetInitialDirtyBitsMask() const {
+    return HdChangeTracker::Clean | HdChangeTracker::InitRepr | HdChangeTracker::DirtyPoints |
+           HdChangeTracker::DirtyTopology | HdChangeTracker::DirtyTransform | HdChangeTracker::DirtyVisibility |
+           HdChangeTracker::DirtyPrimvar | HdChangeTracker::DirtyInstancer | HdChangeTracker::DirtyInstanceIndex |
+           HdChangeTracker::DirtyParams | HdChangeTracker::DirtyMaterialId;
+}
+
+HdDirtyBits HdVolPhotonMesh::_PropagateDirtyBits(HdDirtyBits bits) const { return bits; }
+
+void HdVolPhotonMesh::_InitRepr(TfToken const &reprToken, HdDirtyBits *) {
+    // One representation: the core ray traces the triangles whatever the repr asks for.
+    if (std::find_if(_reprs.begin(), _reprs.end(), _ReprComparator(reprToken)) == _reprs.end())
+        _reprs.emplace_back(reprToken, HdReprSharedPtr());
+}
+
+void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *renderParam, HdDirtyBits *dirtyBits,
+                           TfToken const &) {
+    SdfPath const &id = GetId();
+    HdVolPhoton_MeshRecord rec;
+    rec.mesh.name = id.GetString();
+
+    VtValue pointsValue = sceneDelegate->Get(id, HdTokens->points);
+    VtVec3fArray points = pointsValue.IsHolding<VtVec3fArray>() ? pointsValue.UncheckedGet<VtVec3fArray>() : VtVec3fArray();
+    for (GfVec3f const &p : points) rec.mesh.points.push_back({p[0], p[1], p[2]});
+
+    HdMeshTopology topology = GetMeshTopology(sceneDelegate);
+    HdMeshUtil meshUtil(&topology, id);
+    VtVec3iArray triangles;
+    VtIntArray primitiveParams;
+    meshUtil.ComputeTriangleIndices(&triangles, &primitiveParams);
+    size_t dropped = 0;
+    for (GfVec3i const &t : triangles) {
+        bool valid = true;
+        for (int k = 0; k < 3; ++k) valid &= t[k] >= 0 && static_cast<size_t>(t[k]) < points.size();
+        if (!valid) { ++dropped; continue; }
+        rec.mesh.indices.insert(rec.mesh.indices.end(), {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+    }
+    if (dropped) TF_WARN("%s: %zu triangles index points out of range; dropped", id.GetText(), dropped);
+    for (volphoton::Vec3 const &p : rec.mesh.points)
+        if (!volphoton::isFinite(p)) {
+            TF_WARN("%s.points: non-finite point; mesh skipped", id.GetText());
+            rec.mesh.indices.clear();
+            break;
+        }
+
+    VtValue color = sceneDelegate->Get(id, HdTokens->displayColor);
+    if (color.IsHolding<VtVec3fArray>() && !color.UncheckedGet<VtVec3fArray>().empty())
+        rec.mesh.material.albedo = HdVolPhoton_ToSpectrum(color.UncheckedGet<VtVec3fArray>()[0]);
+    else if (color.IsHolding<GfVec3f>())
+        rec.mesh.material.albedo = HdVolPhoton_ToSpectrum(color.UncheckedGet<GfVec3f>());
+    // XXX: UsdPreviewSurface networks (diffuseColor, emissiveColor) are read by the usd-core front
+    //      end only; the delegate uses displayColor.
+
+    if (auto medium = HdVolPhoton_ReadMediumParams(sceneDelegate, id)) {
+        rec.hasMedium = true;
+        rec.medium = *medium;
+    }
+
+    if (sceneDelegate->GetVisible(id)) {
+        GfMatrix4d objectToWorld = sceneDelegate->GetTransform(id);
+        SdfPath const &instancerId = GetInstancerId();
+        if (instancerId.IsEmpty()) {
+            rec.instances.push_back(HdVolPhoton_ToAffine(objectToWorld));
+        } else {
+            _UpdateInstancer(sceneDelegate, dirtyBits);
+            HdInstancer::_SyncInstancerAndParents(sceneDelegate->GetRenderIndex(), instancerId);
+            auto *instancer = static_cast<HdVolPhotonInstancer *>(sceneDelegate->GetRenderIndex().GetInstancer(instancerId));
+            if (instancer)
+                for (GfMatrix4d const &m : instancer->ComputeInstanceTransforms(id))
+                    rec.instances.push_back(HdVolPhoton_ToAffine(objectToWorld * m));
+        }
+        size_t singular = 0;
+        for (volphoton::Affine const &a : rec.instances) singular += !a.inverse();
+        if (singular) TF_WARN("%s: %zu instance transforms are not invertible or not finite; those are skipped", id.GetText(), singular);
+    }
+
+    static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit().SetMesh(id, std::move(rec));
+    *dirtyBits &= ~HdChangeTracker::AllSceneDirtyBits;
+}
+
+void HdVolPhotonMesh::Finalize(HdRenderParam *renderParam) {
+    static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit().Remove(GetId());
+}
+
+PXR_NAMESPACE_CLOSE_SCOPE

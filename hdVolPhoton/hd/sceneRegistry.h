@@ -1,0 +1,76 @@
+// hdVolPhoton: the plain descriptions Hydra prims sync into, and their translation into the core's
+// SceneDesc. No Hydra prim types here: the prims parse, this assembles.
+#ifndef HDVOLPHOTON_SCENE_REGISTRY_H
+#define HDVOLPHOTON_SCENE_REGISTRY_H
+
+#include "pxr/pxr.h"
+#include "pxr/usd/sdf/path.h"
+
+#include "core/scene.h"
+#include "hd/mediumParams.h"
+
+#include <map>
+#include <mutex>
+
+PXR_NAMESPACE_OPEN_SCOPE
+
+/// A mesh as synced: object-space triangles, one world transform per instance, its surface and,
+/// when it carries VolPhotonMediumAPI, the medium it bounds.
+struct HdVolPhoton_MeshRecord {
+    volphoton::MeshDesc mesh;                  ///< object space; interiorMedium set by the registry
+    std::vector<volphoton::Affine> instances;  ///< world transforms (one when not instanced)
+    bool hasMedium = false;
+    HdVolPhoton_MediumParams medium;
+};
+
+/// An OpenVDB field prim (openvdbAsset): where its grid is.
+struct HdVolPhoton_FieldRecord {
+    std::string filePath;
+    std::string fieldName;
+    int fieldIndex = 0;
+};
+
+/// A volume as synced: its medium parameters, transform and the field prims it binds by name
+/// (density, temperature, emission, albedo).
+struct HdVolPhoton_VolumeRecord {
+    HdVolPhoton_MediumParams medium;
+    volphoton::Affine objectToWorld;
+    std::map<std::string, SdfPath> fields;
+};
+
+/// \class HdVolPhoton_SceneRegistry
+///
+/// Everything the prims have synced, keyed by prim path. Prims write to it only through
+/// HdVolPhotonRenderParam::AcquireSceneForEdit(); Sync runs in parallel, so each write takes the
+/// registry's lock. BuildSceneDesc() runs on the render pass thread while rendering is stopped.
+class HdVolPhoton_SceneRegistry
+{
+public:
+    void SetMesh(SdfPath const &id, HdVolPhoton_MeshRecord record);
+    void SetVolume(SdfPath const &id, HdVolPhoton_VolumeRecord record);
+    void SetField(SdfPath const &id, HdVolPhoton_FieldRecord record);
+    void SetLight(SdfPath const &id, volphoton::LightPtr light);
+    void Remove(SdfPath const &id);
+
+    /// Translates everything into the core's description: loads VDB grids (cached by file, grid
+    /// and parameters), builds media and lights. Problems become TF_WARN messages naming the prim,
+    /// and the prim is left out; the rest still renders.
+    volphoton::SceneDesc BuildSceneDesc(volphoton::CameraDesc const &camera) const;
+
+    /// Counts for render stats.
+    size_t GetMeshCount() const;
+    size_t GetVolumeCount() const;
+    size_t GetLightCount() const;
+
+private:
+    mutable std::mutex _mutex;
+    std::map<SdfPath, HdVolPhoton_MeshRecord> _meshes;
+    std::map<SdfPath, HdVolPhoton_VolumeRecord> _volumes;
+    std::map<SdfPath, HdVolPhoton_FieldRecord> _fields;
+    std::map<SdfPath, volphoton::LightPtr> _lights;
+    mutable std::map<std::string, volphoton::MediumPtr> _gridCache;
+};
+
+PXR_NAMESPACE_CLOSE_SCOPE
+
+#endif  // HDVOLPHOTON_SCENE_REGISTRY_H
