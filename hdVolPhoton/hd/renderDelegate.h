@@ -1,0 +1,102 @@
+// hdVolPhoton: the render delegate.
+#ifndef HDVOLPHOTON_RENDER_DELEGATE_H
+#define HDVOLPHOTON_RENDER_DELEGATE_H
+
+#include "pxr/pxr.h"
+#include "pxr/base/tf/staticTokens.h"
+#include "pxr/imaging/hd/renderDelegate.h"
+#include "pxr/imaging/hd/renderThread.h"
+
+#include "core/integrator.h"
+#include "hd/renderer.h"
+
+#include <atomic>
+#include <memory>
+
+PXR_NAMESPACE_OPEN_SCOPE
+
+class HdVolPhotonRenderParam;
+
+/// Render settings (descriptors; the same meanings as hdVolPhoton/core/integrator.h):
+/// | key                          | type  | default    | meaning                                      |
+/// |------------------------------|-------|------------|----------------------------------------------|
+/// | volphoton:integrator         | token | pathTracer | pathTracer or photonMap                      |
+/// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes              |
+/// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
+/// | volphoton:maxDepth           | int   | 64         | scattering/bounce events per path            |
+/// | volphoton:photonsPerPass     | int   | 100000     | photonMap: photons per pass                  |
+/// | volphoton:initialRadius      | float | 0 (auto)   | photonMap: beam radius of pass 0             |
+/// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |
+/// | volphoton:multipleScattering | bool  | true       | photonMap: photon pass on/off                |
+/// | volphoton:seed               | int   | 0          | random seed                                  |
+#define HDVOLPHOTON_RENDER_SETTINGS_TOKENS \
+    ((integrator, "volphoton:integrator"))  \
+    ((maxDepth, "volphoton:maxDepth"))      \
+    ((photonsPerPass, "volphoton:photonsPerPass")) \
+    ((initialRadius, "volphoton:initialRadius"))   \
+    ((singleScattering, "volphoton:singleScattering")) \
+    ((multipleScattering, "volphoton:multipleScattering")) \
+    ((seed, "volphoton:seed"))              \
+    (pathTracer)                            \
+    (photonMap)
+
+TF_DECLARE_PUBLIC_TOKENS(HdVolPhotonRenderSettingsTokens, HDVOLPHOTON_RENDER_SETTINGS_TOKENS);
+
+/// \class HdVolPhotonRenderDelegate
+///
+/// Owns the render thread, the scene version, the render param (edit gate + scene registry) and the
+/// renderer driver; creates the prims (meshes, volumes, openvdbAsset fields, UsdLux lights, cameras,
+/// render buffers, instancers) and render passes. Threading: prims Sync in parallel into the
+/// registry through the edit gate; the render thread only reads the core scene built from it.
+class HdVolPhotonRenderDelegate final : public HdRenderDelegate
+{
+public:
+    HdVolPhotonRenderDelegate();
+    explicit HdVolPhotonRenderDelegate(HdRenderSettingsMap const &settingsMap);
+    ~HdVolPhotonRenderDelegate() override;
+
+    HdRenderParam *GetRenderParam() const override;
+    TfTokenVector const &GetSupportedRprimTypes() const override;
+    TfTokenVector const &GetSupportedSprimTypes() const override;
+    TfTokenVector const &GetSupportedBprimTypes() const override;
+    HdResourceRegistrySharedPtr GetResourceRegistry() const override;
+    HdRenderSettingDescriptorList GetRenderSettingDescriptors() const override;
+    VtDictionary GetRenderStats() const override;
+    bool IsPauseSupported() const override { return true; }
+    bool Pause() override;
+    bool Resume() override;
+    bool IsStopSupported() const override { return true; }
+    bool Stop(bool blocking = true) override;
+    bool Restart() override;
+
+    HdRenderPassSharedPtr CreateRenderPass(HdRenderIndex *index, HdRprimCollection const &collection) override;
+    HdInstancer *CreateInstancer(HdSceneDelegate *delegate, SdfPath const &id) override;
+    void DestroyInstancer(HdInstancer *instancer) override;
+    HdRprim *CreateRprim(TfToken const &typeId, SdfPath const &rprimId) override;
+    void DestroyRprim(HdRprim *rPrim) override;
+    HdSprim *CreateSprim(TfToken const &typeId, SdfPath const &sprimId) override;
+    HdSprim *CreateFallbackSprim(TfToken const &typeId) override;
+    void DestroySprim(HdSprim *sPrim) override;
+    HdBprim *CreateBprim(TfToken const &typeId, SdfPath const &bprimId) override;
+    HdBprim *CreateFallbackBprim(TfToken const &typeId) override;
+    void DestroyBprim(HdBprim *bPrim) override;
+    void CommitResources(HdChangeTracker *tracker) override {}
+    HdAovDescriptor GetDefaultAovDescriptor(TfToken const &name) const override;
+
+    /// The render settings as the core's struct (read when a render starts).
+    volphoton::RenderSettings GetCoreSettings() const;
+
+private:
+    void _Initialize();
+
+    std::atomic<int> _sceneVersion{0};
+    HdRenderThread _renderThread;
+    HdVolPhoton_Renderer _renderer;
+    std::unique_ptr<HdVolPhotonRenderParam> _renderParam;
+    HdRenderSettingDescriptorList _settingDescriptors;
+    HdResourceRegistrySharedPtr _resourceRegistry;
+};
+
+PXR_NAMESPACE_CLOSE_SCOPE
+
+#endif  // HDVOLPHOTON_RENDER_DELEGATE_H

@@ -1,0 +1,114 @@
+#include "hd/renderer.h"
+
+#include "pxr/base/tf/diagnostic.h"
+#include "pxr/base/vt/array.h"
+#include "pxr/base/vt/types.h"
+#include "pxr/imaging/hd/tokens.h"
+
+#include "hd/renderBuffer.h"
+
+#include <chrono>
+#include <thread>
+
+PXR_NAMESPACE_OPEN_SCOPE
+
+using namespace volphoton;
+
+void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSettings const &settings,
+                                    GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings) {
+    _scene = std::move(scene);
+    _settings = settings;
+    _projection = projection;
+    _aovBindings = aovBindings;
+    std::lock_guard<std::mutex> lock(_statsMutex);
+    _stats = RenderStats();
+    _converged = false;
+}
+
+bool HdVolPhoton_Renderer::IsConverged() const {
+    std::lock_guard<std::mutex> lock(_statsMutex);
+    return _converged;
+}
+
+VtDictionary HdVolPhoton_Renderer::GetStats() const {
+    std::lock_guard<std::mutex> lock(_statsMutex);
+    VtDictionary d;
+    d["passes"] = VtValue(_stats.passes);
+    d["samplesPerPixel"] = VtValue(_stats.passes);
+    d["cameraSamples"] = VtValue(static_cast<uint64_t>(_stats.cameraSamples));
+    d["photonsTraced"] = VtValue(static_cast<uint64_t>(_stats.photonsTraced));
+    d["photonsStored"] = VtValue(static_cast<uint64_t>(_stats.photonsStored));
+    d["photonRadius"] = VtValue(_stats.photonRadius);
+    d["totalSeconds"] = VtValue(_stats.seconds);
+    d["photonSeconds"] = VtValue(_stats.photonSeconds);
+    d["cameraSeconds"] = VtValue(_stats.cameraSeconds);
+    d["passesRun"] = VtValue(VtStringArray(_stats.passesRun.begin(), _stats.passesRun.end()));
+    d["passesSkipped"] = VtValue(VtStringArray(_stats.passesSkipped.begin(), _stats.passesSkipped.end()));
+    d["percentDone"] = VtValue(_settings.samplesPerPixel > 0 ? 100.0 * _stats.passes / _settings.samplesPerPixel : 100.0);
+    return d;
+}
+
+void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
+    if (!_scene) return;
+    std::unique_ptr<Renderer> renderer;
+    try {
+        renderer = std::make_unique<Renderer>(_scene, _settings);
+    } catch (std::exception const &e) {
+        TF_WARN("hdVolPhoton: cannot render: %s", e.what());
+        return;
+    }
+    auto cancel = [thread]() { return thread->IsStopRequested(); };
+    for (int pass = 0; pass < _settings.samplesPerPixel; ++pass) {
+        while (thread->IsPauseRequested() && !thread->IsStopRequested())
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (!renderer->renderPass(cancel)) break;
+        {
+            std::lock_guard<std::mutex> lock(_statsMutex);
+            _stats = renderer->stats();
+            _converged = pass + 1 == _settings.samplesPerPixel;
+        }
+        auto fb = thread->LockFramebuffer();
+        _WriteAovs(renderer->film());
+    }
+}
+
+void HdVolPhoton_Renderer::_WriteAovs(Film const &film) {
+    bool converged = IsConverged();
+    for (HdRenderPassAovBinding const &b : _aovBindings) {
+        auto *buffer = static_cast<HdVolPhotonRenderBuffer *>(b.renderBuffer);
+        if (!buffer || buffer->GetWidth() != static_cast<unsigned>(film.width()) ||
+            buffer->GetHeight() != static_cast<unsigned>(film.height()))
+            continue;
+        TfToken const &name = b.aovName;
+        if (name == HdAovTokens->color) {
+            std::vector<float> alpha = film.resolveAlpha();
+            buffer->WriteFloats(film.resolveRgb(Film::Beauty), 3, 1.0f, &alpha);
+        } else if (name == HdAovTokens->depth) {
+            // Hydra wants depth in [0, 1] after the projection; the core stores the ray distance t.
+            std::vector<float> t = film.resolveDepth(), depth(t.size(), 1.0f);
+            bool perspective = _projection[3][3] == 0.0;
+            for (int y = 0; y < film.height(); ++y)
+                for (int x = 0; x < film.width(); ++x) {
+                    size_t i = static_cast<size_t>(y) * film.width() + x;
+                    if (!std::isfinite(t[i])) continue;
+                    double sx = (2.0 * (x + 0.5) / film.width() - 1.0) / _projection[0][0];
+                    double sy = (1.0 - 2.0 * (y + 0.5) / film.height()) / _projection[1][1];
+                    double z = perspective ? -t[i] / std::sqrt(1 + sx * sx + sy * sy) : -t[i];
+                    double clipZ = _projection[2][2] * z + _projection[3][2], clipW = _projection[2][3] * z + _projection[3][3];
+                    depth[i] = static_cast<float>(std::clamp(0.5 * (clipZ / clipW) + 0.5, 0.0, 1.0));
+                }
+            buffer->WriteFloats(depth, 1);
+        } else if (name == HdAovTokens->primId || name == HdAovTokens->instanceId || name == HdAovTokens->elementId) {
+            // XXX: the core does not report which prim a pixel saw yet; -1 is "nothing".
+            buffer->WriteInts(std::vector<int>(static_cast<size_t>(film.width()) * film.height(), -1));
+        } else {
+            static const std::pair<char const *, Film::Aov> split[] = {
+                {"single", Film::Single}, {"multiple", Film::Multiple}, {"emission", Film::Emission}, {"surface", Film::Surface}};
+            for (auto const &[aov, which] : split)
+                if (name == aov) buffer->WriteFloats(film.resolveRgb(which), 3);
+        }
+        buffer->SetConverged(converged);
+    }
+}
+
+PXR_NAMESPACE_CLOSE_SCOPE
