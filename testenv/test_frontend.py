@@ -838,9 +838,15 @@ def test_missing_scene_and_bad_options(tmp_path):
     bad.write_text("#usda 1.0\ndef Xform \"x\" {\n  this is not usd\n")
     r = run_cli("render", bad, "-o", tmp_path / "o.exr")
     assert r.returncode == 1 and "cannot open scene" in one_line_error(r)
+    # A missing output folder is created (farm tasks often write the first frame into a new one) ...
     r = run_cli("render", os.path.join(TESTENV, "furnace.usda"), "-o", tmp_path / "missing_dir" / "o.exr",
                 "--resolution", "4", "4", "--spp", "1")
-    assert r.returncode == 1 and "missing_dir" in one_line_error(r)
+    assert r.returncode == 0 and (tmp_path / "missing_dir" / "o.exr").exists()
+    # ... and one that cannot be created is a clear error naming it.
+    (tmp_path / "a_file").write_text("x")
+    r = run_cli("render", os.path.join(TESTENV, "furnace.usda"), "-o", tmp_path / "a_file" / "o.exr",
+                "--resolution", "4", "4", "--spp", "1")
+    assert r.returncode == 1 and "a_file" in one_line_error(r)
 
 
 def render_bad(tmp_path, body, *extra):

@@ -386,9 +386,9 @@ def _settings(core, args, rs_info, width: int, height: int):
 
 
 def _write_json(path: str, data) -> None:
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise OSError("output directory %s does not exist" % directory)
+    from . import output
+
+    output.ensure_directory(path)
     tmp = path + ".tmp%d" % os.getpid()
     with open(tmp, "w") as f:
         json.dump(data, f, indent=2, sort_keys=False, default=lambda o: str(o))

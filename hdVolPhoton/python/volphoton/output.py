@@ -36,6 +36,16 @@ from . import _core
 LAYERS = ("single", "multiple", "emission", "surface")
 
 
+
+def ensure_directory(path: str) -> None:
+    """Creates the directory an output file goes to (a farm task's first frame often meets a new
+    folder); raises OSError naming it when that is impossible."""
+    directory = os.path.dirname(os.path.abspath(path))
+    try:
+        os.makedirs(directory, exist_ok=True)
+    except OSError as e:
+        raise OSError("cannot create output directory %s: %s" % (directory, e.strerror or e)) from None
+
 def film_planes(film) -> Dict[str, np.ndarray]:
     """{channel name: (H, W) float32} of a core Film in the layout above."""
     planes: Dict[str, np.ndarray] = {}
@@ -61,9 +71,7 @@ def _temp_path(path: str, suffix: str) -> str:
 
 def write_exr(path: str, planes: Dict[str, np.ndarray], attributes: Optional[Dict[str, str]] = None) -> None:
     """Writes the planes atomically (temporary file + rename)."""
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise OSError("output directory %s does not exist" % directory)
+    ensure_directory(path)
     tmp = _temp_path(path, ".exr")
     try:
         _core.write_exr(tmp, planes, attributes or {})
@@ -92,9 +100,7 @@ def write_display_image(path: str, rgb: np.ndarray, transform, quality: int = 95
 
     pixels = transform.to_uint8(np.ascontiguousarray(rgb, dtype=np.float32))
     ext = os.path.splitext(path)[1].lower()
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise OSError("output directory %s does not exist" % directory)
+    ensure_directory(path)
     fmt = Image.registered_extensions().get(ext)
     if fmt is None:
         raise ValueError("cannot write '%s': unknown image extension '%s' (use .png or .jpg)" % (path, ext))

@@ -55,7 +55,9 @@ Media (volphoton.schema.read_medium, documented in schemas/README.md)
       (``MeshDesc.interior_medium``).
     * ``volphoton:preset`` (measured coefficients in 1/mm, Jensen et al. 2001, as reduced
       scattering + absorption) replaces density, albedo and extinctionColor:
-      sigma = sigma_mm / sceneUnitsPerMm.  Presets: see ``PRESETS``.  Unknown presets: warning.
+      sigma_s = sigma_s' / (1 - g) / sceneUnitsPerMm, sigma_a = sigma_a / sceneUnitsPerMm, with g the
+      mean cosine of the prim's phase.  Table and mapping: ``volphoton.presets`` (``PRESETS`` here is
+      the same dict).  An unknown preset is an error; the authored coefficients are used.
     * Phase: isotropic, linear(x), rayleigh, lambertianSphere, henyeyGreenstein(g), schlick(k),
       tabulated(table), mixture(lobes) -> the core factories.
 
@@ -101,6 +103,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdRender, UsdShade, UsdVol
 
 from . import _core
+from . import presets as vpresets
 from . import schema as vschema
 from .schema import Diagnostic
 
@@ -120,22 +123,8 @@ __all__ = [
     "tessellate",
 ]
 
-# Measured subsurface coefficients (Jensen, Marschner, Levoy, Hanrahan 2001, "A Practical Model for
-# Subsurface Light Transport", table 2): (reduced scattering sigma_s', absorption sigma_a) in 1/mm,
-# RGB.  Used with the (isotropic) phase of the prim: the reduced coefficients already fold in g.
-PRESETS: Dict[str, Tuple[Tuple[float, float, float], Tuple[float, float, float]]] = {
-    "apple": ((2.29, 2.39, 1.97), (0.0030, 0.0034, 0.046)),
-    "chicken1": ((0.15, 0.21, 0.38), (0.015, 0.077, 0.19)),
-    "chicken2": ((0.19, 0.25, 0.32), (0.018, 0.088, 0.20)),
-    "cream": ((7.38, 5.47, 3.15), (0.0002, 0.0028, 0.0163)),
-    "ketchup": ((0.18, 0.07, 0.03), (0.061, 0.97, 1.45)),
-    "marble": ((2.19, 2.62, 3.00), (0.0021, 0.0041, 0.0071)),
-    "potato": ((0.68, 0.70, 0.55), (0.0024, 0.0090, 0.12)),
-    "skimmilk": ((0.70, 1.22, 1.90), (0.0014, 0.0025, 0.0142)),
-    "skin1": ((0.74, 0.88, 1.01), (0.032, 0.17, 0.48)),
-    "skin2": ((1.09, 1.59, 1.79), (0.013, 0.070, 0.145)),
-    "wholemilk": ((2.55, 3.21, 3.77), (0.0011, 0.0024, 0.014)),
-}
+# Measured subsurface coefficients (volphoton:preset): the table lives in volphoton/presets.py.
+PRESETS = vpresets.PRESETS
 
 # Renderer settings read from a UsdRender Settings prim as ``volphoton:<name>`` attributes (the
 # names of integrator.h's table): name -> (RenderSettings field, Python type).
@@ -660,16 +649,13 @@ def _coefficients(md: vschema.MediumDesc, prim_path: str, d: _Diags):
     """(density, extinction colour, albedo) after applying a preset."""
     density, ext, albedo = md.density, md.extinction_color, md.albedo
     if md.preset:
-        preset = PRESETS.get(md.preset)
-        if preset is None:
-            d.warn(prim_path, "volphoton:preset", "unknown preset '%s' (known: %s); ignored"
-                   % (md.preset, ", ".join(sorted(PRESETS))))
+        try:
+            g = phase_to_core(md.phase).mean_cosine()  # sigma_s = sigma_s' / (1 - g)
+            c = vpresets.preset_coefficients(md.preset, md.scene_units_per_mm, g)
+        except (vpresets.UnknownPresetError, ValueError) as e:
+            d.error(prim_path, "volphoton:preset", "%s; using the authored density, albedo and extinctionColor" % e)
         else:
-            ss, sa = np.array(preset[0]), np.array(preset[1])
-            st = (ss + sa) / md.scene_units_per_mm
-            density = float(st.max())
-            ext = _tuple3(st / density)
-            albedo = _tuple3(ss / (ss + sa))
+            density, ext, albedo = c.density, c.extinction_color, c.albedo
     return density, ext, albedo
 
 
