@@ -79,6 +79,20 @@ Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double di
     return Spectrum(0.0);
 }
 
+Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng,
+                                        bool mis) const {
+    const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+    DirectSample ds = sampleDirect(hit.p, rng);
+    Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
+    double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
+    // The light must be on the viewer's side of the geometric surface too (no light leaks through).
+    if (!(cosL > 0) || !(ds.ls.pdf > 0) || ds.ls.Li.isBlack() || dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
+    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
+    double lightDensity = ds.pickProb * ds.ls.pdf;
+    double w = mis && !ds.ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
+    return m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity);
+}
+
 SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng,
                                           bool radianceMode) const {
     SurfaceScatter s;

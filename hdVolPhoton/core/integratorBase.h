@@ -46,6 +46,10 @@ protected:
     /// Transmittance from p along unit w over dist, through media and index-matched boundaries;
     /// 0 if any other surface blocks. `stack` is the medium stack at p.
     Spectrum shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng) const;
+    /// Next-event estimate at a lambertian hit for a path arriving along ray.d: albedo/pi cos T Li / pdf
+    /// for one light picked by power. With `mis`, lights with extent are weighted by the power
+    /// heuristic against cosine sampling (the path tracer); without, light sampling stands alone.
+    Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
     /// Origin offset off a surface towards the side of direction w.

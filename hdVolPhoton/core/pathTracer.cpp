@@ -171,17 +171,8 @@ public:
             if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
                 add(beta * m.emission, false);  // emissive meshes are found by hits only (no light sampling)
             if (++depth > settings_.maxDepth) break;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack()) {
-                DirectSample ds = sampleDirect(hit.p, rng);
-                Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
-                double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
-                if (cosL > 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack() && dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) > 0) {
-                    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
-                    double lightDensity = ds.pickProb * ds.ls.pdf;
-                    double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, cosL * InvPi);
-                    add(beta * m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity), false);
-                }
-            }
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
+                add(beta * directAtLambertian(ray, hit, stack, rng, true), false);
             SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
             if (s.type == SurfaceScatter::Type::Absorbed) break;
             beta *= s.weight;

@@ -141,15 +141,8 @@ public:
             if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
                 out.surface += beta * m.emission;
             if (++depth > settings_.maxDepth) break;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack()) {
-                DirectSample ds = sampleDirect(hit.p, rng);
-                Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
-                double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
-                if (cosL > 0 && ds.ls.pdf > 0 && dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) > 0) {
-                    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
-                    out.surface += beta * m.albedo * (cosL * InvPi) * T * ds.ls.Li / (ds.pickProb * ds.ls.pdf);
-                }
-            }
+            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
+                out.surface += beta * directAtLambertian(ray, hit, stack, rng, false);
             SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
             if (s.type == SurfaceScatter::Type::Absorbed) break;
             beta *= s.weight;

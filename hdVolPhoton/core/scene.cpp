@@ -84,6 +84,10 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     for (const auto& m : desc_.media) emissiveMedia_ |= m->isEmissive();
     hasMedia_ = !desc_.unboundedMedia.empty();
     for (const auto& m : desc_.meshes) hasMedia_ |= m.interiorMedium >= 0;
+#ifdef VOLPHOTON_NO_VOLUMES
+    if (hasMedia_) warn("this core is built with VOLPHOTON_NO_VOLUMES: the scene's media are ignored");
+    hasMedia_ = emissiveMedia_ = false;
+#endif
     if (bounds.empty()) bounds.extend(Vec3(0, 0, 0));
     center_ = (bounds.lo + bounds.hi) * 0.5;
     radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
@@ -146,6 +150,10 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
 
 MediumAggregate Scene::mediaFor(const MediumStack& stack) const {
     MediumAggregate agg;
+#ifdef VOLPHOTON_NO_VOLUMES
+    (void)stack;
+    return agg;
+#endif
     for (int i : desc_.unboundedMedia) agg.add(desc_.media[i].get());
     int inner = stack.innermost();
     if (inner >= 0 && desc_.meshes[inner].interiorMedium >= 0) agg.add(desc_.media[desc_.meshes[inner].interiorMedium].get());

@@ -107,9 +107,16 @@ public:
     const SceneDesc& desc() const { return desc_; }
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
     const std::vector<LightPtr>& lights() const { return desc_.lights; }
+#ifdef VOLPHOTON_NO_VOLUMES
+    // Benchmark baseline (CMake option VOLPHOTON_NO_VOLUMES): media are ignored and every
+    // `if (scene.hasMedia())` branch of the integrators is dead code the compiler removes.
+    constexpr bool hasMedia() const { return false; }
+    constexpr bool hasEmissiveMedia() const { return false; }
+#else
     bool hasMedia() const { return hasMedia_; }
-    bool hasSurfaces() const { return !desc_.instances.empty(); }
     bool hasEmissiveMedia() const { return emissiveMedia_; }
+#endif
+    bool hasSurfaces() const { return !desc_.instances.empty(); }
     /// Bounding sphere of geometry and bounded media (for distant and dome light photons).
     Vec3 center() const { return center_; }
     double radius() const { return radius_; }
