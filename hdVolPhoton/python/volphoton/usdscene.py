@@ -105,6 +105,7 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdRender, UsdShade, UsdVol
 from . import _core
 from . import presets as vpresets
 from . import schema as vschema
+from . import vdbguard
 from .schema import Diagnostic
 
 __all__ = [
@@ -958,6 +959,11 @@ class _Translator:
         gd.temperature_scale = md.temperature_scale
         gd.phase = phase_to_core(md.phase)
         gd.object_to_world = world
+        problem = vdbguard.crash_check(gd.file_path, gd.density_grid)
+        if problem:
+            self.d.error(dens.prim_path, "filePath", "field:density of %s (file %s): %s; volume skipped"
+                         % (path, dens.file_path, problem))
+            return None
         try:
             return _core.load_grid_medium(gd)
         except (RuntimeError, ValueError) as e:
