@@ -29,7 +29,7 @@ PYTHON=${PYTHON:-python3}
 # shellcheck disable=SC1091
 . .venv/bin/activate
 pip install -q --upgrade pip
-pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy "usd-core>=24.8" Pillow pytest jinja2 iadpython matplotlib
+pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy "usd-core>=24.8" Pillow pytest jinja2 iadpython scipy matplotlib
 echo "setup: building and installing the volphoton Python package (C++ core + bindings)"
 CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)} pip install -q --no-build-isolation .
 

@@ -55,14 +55,15 @@ bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, 
     return found;
 }
 
-Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng) const {
+Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng,
+                                         double tMin) const {
     Spectrum T(1.0);
     Ray ray{p, w};
     double travelled = 0;
     for (int crossings = 0; crossings < 64; ++crossings) {
         SurfaceHit hit;
         double remaining = dist - travelled;
-        bool blocked = scene_.intersect(ray, 0.0, remaining * (1 - 1e-7) - scene_.epsilon(), &hit);
+        bool blocked = scene_.intersect(ray, tMin, remaining * (1 - 1e-7) - scene_.epsilon(), &hit);
         double segment = blocked ? hit.t : remaining;
         if (scene_.hasMedia()) {
             MediumAggregate media = scene_.mediaFor(stack);
@@ -72,11 +73,21 @@ Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double di
         if (!blocked) return T;
         if (scene_.mesh(hit.mesh).material.kind != SurfaceMaterial::Kind::Boundary) return Spectrum(0.0);
         stack.toggle(hit.mesh);
-        Vec3 o = offset(hit, w);
-        travelled += length(o - ray.o);
-        ray.o = o;
+        travelled += hit.t;
+        ray.o = hit.p;
+        tMin = spawnTMin(hit, w);
     }
     return Spectrum(0.0);
+}
+
+double Integrator::leakDistance(const MediumStack& stack, const Ray& ray) const {
+    int mesh = stack.innermost();
+    if (mesh < 0) return Infinity;
+    static std::atomic<bool> warned{false};
+    if (!warned.exchange(true))
+        warn("mesh '" + scene_.mesh(mesh).name + "' bounds a medium but is not closed: rays leave it through a hole; "
+             "its medium is cut at the mesh's bounding box");
+    return scene_.exitDistance(mesh, ray);
 }
 
 Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng,
@@ -87,7 +98,7 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
     double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
     // The light must be on the viewer's side of the geometric surface too (no light leaks through).
     if (!(cosL > 0) || !(ds.ls.pdf > 0) || ds.ls.Li.isBlack() || dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
-    Spectrum T = shadowTransmittance(offset(hit, ds.ls.wi), ds.ls.wi, ds.ls.dist, stack, rng);
+    Spectrum T = shadowTransmittance(hit.p, ds.ls.wi, ds.ls.dist, stack, rng, spawnTMin(hit, ds.ls.wi));
     double lightDensity = ds.pickProb * ds.ls.pdf;
     double w = mis && !ds.ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
     return m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity);
@@ -102,7 +113,8 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
         case SurfaceMaterial::Kind::Boundary:
             stack.toggle(hit.mesh);
             s.type = SurfaceScatter::Type::Pass;
-            s.next = {offset(hit, ray.d), ray.d};
+            s.next = {hit.p, ray.d};
+            s.tMin = spawnTMin(hit, ray.d);
             s.crossed = true;
             return s;
         case SurfaceMaterial::Kind::Lambertian: {
@@ -111,7 +123,8 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
             Vec3 w = Frame::fromZ(n).toWorld(cosineHemisphere(rng.uniform(), rng.uniform()));
             if (dot(w, hit.ng) * dot(wo, hit.ng) <= 0) return s;  // shading normal sent it below the surface
             s.type = SurfaceScatter::Type::Diffuse;
-            s.next = {offset(hit, w), w};
+            s.next = {hit.p, w};
+            s.tMin = spawnTMin(hit, w);
             s.weight = m.albedo;  // f cos / pdf = (albedo/pi) cos / (cos/pi)
             return s;
         }
@@ -124,14 +137,16 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
             if (rng.uniform() < F) {
                 Vec3 r = n * (2 * cosI) - wo;
                 s.type = SurfaceScatter::Type::Specular;
-                s.next = {offset(hit, r), r};
+                s.next = {hit.p, r};
+                s.tMin = spawnTMin(hit, r);
                 return s;
             }
             double sin2T = (1 - cosI * cosI) / (eta * eta);
             double cosT = std::sqrt(std::max(0.0, 1 - sin2T));
             Vec3 t = normalize(-wo / eta + n * (cosI / eta - cosT));
             s.type = SurfaceScatter::Type::Specular;
-            s.next = {offset(hit, t), t};
+            s.next = {hit.p, t};
+            s.tMin = spawnTMin(hit, t);
             s.crossed = true;
             if (radianceMode) s.weight = Spectrum(1.0 / (eta * eta));
             stack.toggle(hit.mesh);

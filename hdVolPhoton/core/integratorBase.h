@@ -19,7 +19,8 @@ struct DirectSample {
 struct SurfaceScatter {
     enum class Type { Absorbed, Diffuse, Specular, Pass };
     Type type = Type::Absorbed;
-    Ray next;
+    Ray next;              ///< starts exactly at the hit point (media are tracked from there)
+    double tMin = 0;       ///< where the next surface intersection may start (self-hit avoidance)
     Spectrum weight{1.0};  ///< multiplies the path throughput
     bool crossed = false;  ///< the path went through the surface (refraction or boundary)
 };
@@ -44,17 +45,26 @@ protected:
     /// Nearest light with extent hit by ray before tMax (including escape to dome/distant lights).
     bool hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light) const;
     /// Transmittance from p along unit w over dist, through media and index-matched boundaries;
-    /// 0 if any other surface blocks. `stack` is the medium stack at p.
-    Spectrum shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng) const;
+    /// 0 if any other surface blocks. `stack` is the medium stack at p; surfaces are searched from
+    /// t = tMin (a spawn offset off the surface p lies on), media from t = 0.
+    Spectrum shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng,
+                                 double tMin = 0) const;
     /// Next-event estimate at a lambertian hit for a path arriving along ray.d: albedo/pi cos T Li / pdf
     /// for one light picked by power. With `mis`, lights with extent are weighted by the power
     /// heuristic against cosine sampling (the path tracer); without, light sampling stands alone.
     Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
-    /// Origin offset off a surface towards the side of direction w.
-    Vec3 offset(const SurfaceHit& hit, const Vec3& w) const {
-        return hit.p + hit.ng * (dot(w, hit.ng) > 0 ? scene_.epsilon() : -scene_.epsilon());
+    /// Distance at which a path inside a mesh medium with no surface ahead leaves the mesh's bounds
+    /// (infinity when it is inside no mesh). Warns once per render: the mesh is not closed.
+    double leakDistance(const MediumStack& stack, const Ray& ray) const;
+    /// Ray parameter from which a ray leaving `hit` along w may meet surfaces again: clear of the
+    /// surface by the scene epsilon (Embree intersects in single precision). Rays start exactly at
+    /// the hit point, so the medium behind a surface is tracked from the surface itself; offsetting
+    /// the origin instead skipped a layer of medium, which matters when the mean free path is
+    /// below the epsilon.
+    double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
+        return scene_.epsilon() / std::max(std::abs(dot(w, hit.ng)), 1e-2);
     }
 
     const Scene& scene_;

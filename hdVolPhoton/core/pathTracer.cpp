@@ -43,6 +43,7 @@ public:
         int depth = 0, crossings = 0;
         bool firstSegment = true;
         bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
+        double mediumFrom = tMin;       // media start at the camera's near plane, then at each vertex
 
         auto add = [&](const Spectrum& L, bool singleCandidate) {
             if (branch == Branch::Undecided) out.surface += L;  // lights/environment seen directly
@@ -62,18 +63,20 @@ public:
             bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light);
             if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
             if (firstSegment && hasHit) out.depth = hit.t;
+            double leakExit = hasHit ? Infinity : leakDistance(stack, ray);
+            if (leakExit < tEnd) tEnd = leakExit;
 
-            // Medium interaction along [tMin, tEnd].
+            // Medium interaction along [mediumFrom, tEnd].
             bool scattered = false, absorbed = false;
             MediumEvent scatter{};
             MediumAggregate media;
-            Ray local{ray.at(tMin), ray.d};
+            Ray local{ray.at(mediumFrom), ray.d};
             Support support;
             if (scene_.hasMedia()) {
                 media = scene_.mediaFor(stack);
                 if (media.size()) {
                     bool emissive = media.isEmissive();
-                    double length = std::isinf(tEnd) ? 1e30 : tEnd - tMin;
+                    double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
                     if (hasPointLights_) {
                         support = mediaSupport(media, local, length);
                         Spectrum L = equiangularPointLight(media, local, support, stack, beta, rng);
@@ -96,7 +99,7 @@ public:
                         if (u < pa + ps) {
                             beta *= total / (e.sigmaMaj * ps);  // sigma_s goes into the phase kernel below
                             scatter = e;
-                            scatter.t += tMin;
+                            scatter.t += mediumFrom;
                             scattered = true;
                             return false;
                         }
@@ -123,7 +126,7 @@ public:
                         double lightDensity = ds.pickProb * ds.ls.pdf;
                         double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, mp.scatterPdf(cosTheta));
                         if (isPointLight(ds.light)) {  // MIS with the equiangular strategy of this segment
-                            double tLocal = scatter.t - tMin;
+                            double tLocal = scatter.t - mediumFrom;
                             double pd = distanceDensity(media, local, tLocal);
                             double pe = equiangularPdf(ds.light, local, support, tLocal);
                             w = pd / (pd + pe);
@@ -140,11 +143,18 @@ public:
                 prevPdf = pdf;
                 specular = false;
                 ray = {p, w};
-                tMin = 0;
+                tMin = mediumFrom = 0;
                 tMax = Infinity;
                 firstSegment = false;
                 lightHitIsSingle = firstVertex;
                 if (!roulette(beta, depth, rng)) break;
+                continue;
+            }
+            if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
+                stack.toggle(stack.innermost());
+                ray = {ray.at(leakExit), ray.d};
+                tMin = mediumFrom = 0;
+                tMax = std::isinf(tMax) ? tMax : tMax - leakExit;
                 continue;
             }
             bool lightWasSingle = lightHitIsSingle;
@@ -163,7 +173,8 @@ public:
                 if (++crossings > 256) break;
                 SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
                 ray = s.next;
-                tMin = 0;
+                tMin = s.tMin;
+                mediumFrom = 0;
                 tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
                 continue;
             }
@@ -179,7 +190,8 @@ public:
             specular = s.type == SurfaceScatter::Type::Specular;
             if (!specular) prevPdf = std::abs(dot(s.next.d, hit.ns)) * InvPi;
             ray = s.next;
-            tMin = 0;
+            tMin = s.tMin;
+            mediumFrom = 0;
             tMax = Infinity;
             firstSegment = false;
             if (!roulette(beta, depth, rng)) break;

@@ -88,6 +88,7 @@ public:
         MediumStack stack = cameraStack_;
         bool firstSegment = true, onlySpecular = true;
         int depth = 0, crossings = 0;
+        double mediumFrom = tMin;  // media start at the camera's near plane, then at each vertex
         // Which AOV a contribution goes to: the first non-boundary vertex decides (integrator.h).
         auto route = [&](Spectrum& medium) -> Spectrum& { return firstSegment ? medium : out.surface; };
 
@@ -102,13 +103,15 @@ public:
             bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light);
             if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
             if (firstSegment && hasHit) out.depth = hit.t;
+            double leakExit = hasHit ? Infinity : leakDistance(stack, ray);
+            if (leakExit < tEnd) tEnd = leakExit;
 
             Spectrum Tseg(1.0);
             if (scene_.hasMedia()) {
                 MediumAggregate media = scene_.mediaFor(stack);
                 if (media.size()) {
-                    Ray local{ray.at(tMin), ray.d};
-                    double length = std::isinf(tEnd) ? 1e30 : tEnd - tMin;
+                    Ray local{ray.at(mediumFrom), ray.d};
+                    double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
                     SegmentResult seg = integrateSegment(media, local, length, stack, rng);
                     route(out.single) += beta * seg.single;
                     route(out.multiple) += beta * seg.multiple;
@@ -119,6 +122,13 @@ public:
             }
             beta *= Tseg;
             if (beta.isBlack()) break;
+            if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
+                stack.toggle(stack.innermost());
+                ray = {ray.at(leakExit), ray.d};
+                tMin = mediumFrom = 0;
+                tMax = std::isinf(tMax) ? tMax : tMax - leakExit;
+                continue;
+            }
             if (hasLight && (!hasHit || tLight <= hit.t)) {
                 // Lights are found by light sampling at diffuse vertices, so a hit counts only after
                 // the camera or specular bounces.
@@ -133,7 +143,8 @@ public:
                 if (++crossings > 256) break;
                 SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
                 ray = s.next;
-                tMin = 0;
+                tMin = s.tMin;
+                mediumFrom = 0;
                 tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
                 continue;
             }
@@ -148,7 +159,8 @@ public:
             beta *= s.weight;
             onlySpecular = onlySpecular && s.type == SurfaceScatter::Type::Specular;
             ray = s.next;
-            tMin = 0;
+            tMin = s.tMin;
+            mediumFrom = 0;
             tMax = Infinity;
             if (depth >= settings_.rouletteDepth) {
                 double q = std::max(0.0, 1 - beta.maxValue());
@@ -205,9 +217,16 @@ private:
         media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
             supportStart = std::min(supportStart, seg.tMin);
             supportEnd = std::max(supportEnd, seg.tMax);
+            // Steps of at most step_; an unbounded segment (an atmosphere, fog around the camera) is
+            // marched for at most MaxSteps steps, by which the early termination below has usually
+            // ended it. XXX: a thin unbounded medium beyond MaxSteps * step_ is not marched.
+            constexpr double MaxSteps = 1e5;
+            // A step also resolves the segment's mean free path, so thick media are marched finely
+            // enough for the camera transmittance and thin ones cost few steps.
             double len = seg.tMax - seg.tMin;
-            int n = static_cast<int>(std::clamp(std::ceil(len / step_), 1.0, 1e5));
-            double dt = len / n;
+            double stepHere = std::min(step_, 0.25 / seg.sigmaMaj);
+            int n = static_cast<int>(std::clamp(std::ceil(len / stepHere), 1.0, MaxSteps));
+            double dt = std::min(len / n, stepHere);
             for (int i = 0; i < n && !stop; ++i) {
                 double t = seg.tMin + (i + offsetU) * dt;
                 Vec3 p = ray.at(t);
@@ -383,14 +402,16 @@ private:
         }
         if (flux.isBlack() || !flux.isFinite()) return;
         MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
+        double tMin = 0;  // surfaces are searched from here; media from the ray origin
         for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < 256;) {
             SurfaceHit hit;
-            bool hasHit = scene_.intersect(ray, 0.0, Infinity, &hit);
+            bool hasHit = scene_.intersect(ray, tMin, Infinity, &hit);
+            double tEnd = hasHit ? hit.t : std::min(1e30, leakDistance(stack, ray));
             bool scattered = false, absorbed = false;
             MediumEvent ev{};
             MediumAggregate media = scene_.mediaFor(stack);
             if (media.size()) {
-                sampleFreeFlight(media, ray, hasHit ? hit.t : 1e30, rng, [&](const MediumEvent& m) {
+                sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
                     Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
                     for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
                     double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
@@ -439,13 +460,26 @@ private:
                 flux *= mp.scatterKernel(cosTheta) / pdf;
                 for (int c = 0; c < 3; ++c) if (!std::isfinite(flux[c])) flux[c] = 0;
                 ray = {ev.p, w};
+                tMin = 0;
+                continue;
+            }
+            if (!hasHit && tEnd < 1e30) {  // left a broken mesh through a hole
+                stack.toggle(stack.innermost());
+                ray = {ray.at(tEnd), ray.d};
+                tMin = 0;
+                ++crossings;
                 continue;
             }
             if (!hasHit) return;
             const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
             SurfaceScatter s = scatterSurface(ray, hit, stack, rng, false);
             if (s.type == SurfaceScatter::Type::Absorbed) return;
-            if (s.type == SurfaceScatter::Type::Pass) { ++crossings; ray = s.next; continue; }
+            if (s.type == SurfaceScatter::Type::Pass) {
+                ++crossings;
+                ray = s.next;
+                tMin = s.tMin;
+                continue;
+            }
             ++depth;
             if (m.kind == SurfaceMaterial::Kind::Lambertian) {
                 ++events;
@@ -460,6 +494,7 @@ private:
                 flux *= s.weight;
             }
             ray = s.next;
+            tMin = s.tMin;
         }
     }
 

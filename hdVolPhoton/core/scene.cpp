@@ -51,6 +51,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         rtcCommitScene(s);
         meshScenes_.push_back(s);
     }
+    meshBounds_.resize(desc_.meshes.size());
     for (size_t ii = 0; ii < desc_.instances.size(); ++ii) {
         const InstanceDesc& inst = desc_.instances[ii];
         if (inst.mesh < 0 || inst.mesh >= static_cast<int>(meshScenes_.size()))
@@ -72,7 +73,10 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(top_, g, static_cast<unsigned>(ii));
         rtcReleaseGeometry(g);
-        for (const Vec3& p : desc_.meshes[inst.mesh].points) bounds.extend(inst.transform.point(p));
+        for (const Vec3& p : desc_.meshes[inst.mesh].points) {
+            bounds.extend(inst.transform.point(p));
+            meshBounds_[inst.mesh].extend(inst.transform.point(p));
+        }
     }
     rtcCommitScene(top_);
 
@@ -88,7 +92,12 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     if (hasMedia_) warn("this core is built with VOLPHOTON_NO_VOLUMES: the scene's media are ignored");
     hasMedia_ = emissiveMedia_ = false;
 #endif
-    if (bounds.empty()) bounds.extend(Vec3(0, 0, 0));
+    if (bounds.empty()) {  // only unbounded media (or nothing): a unit box around the camera
+        Vec3 eye = desc_.camera.cameraToWorld.point(Vec3());
+        if (!isFinite(eye)) eye = Vec3();
+        bounds.extend(eye - Vec3(1, 1, 1));
+        bounds.extend(eye + Vec3(1, 1, 1));
+    }
     center_ = (bounds.lo + bounds.hi) * 0.5;
     radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
     double extent = std::max({std::abs(bounds.lo.x), std::abs(bounds.lo.y), std::abs(bounds.lo.z), std::abs(bounds.hi.x),
@@ -104,6 +113,12 @@ Scene::~Scene() {
 
 bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit) const {
     if (desc_.instances.empty()) return false;
+    // Embree asserts on rays outside its range (|org| <= FLT_LARGE = 1.844e18 in rtcore_ray.h);
+    // nothing real lies out there.
+    constexpr double FloatSafe = 1e18;
+    if (!isFinite(ray.o) || !isFinite(ray.d) || std::abs(ray.o.x) > FloatSafe || std::abs(ray.o.y) > FloatSafe ||
+        std::abs(ray.o.z) > FloatSafe || !(tMin <= tMax) || !(tMin < FloatSafe))
+        return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -158,6 +173,14 @@ MediumAggregate Scene::mediaFor(const MediumStack& stack) const {
     int inner = stack.innermost();
     if (inner >= 0 && desc_.meshes[inner].interiorMedium >= 0) agg.add(desc_.media[desc_.meshes[inner].interiorMedium].get());
     return agg;
+}
+
+double Scene::exitDistance(int mesh, const Ray& ray) const {
+    double t0, t1;
+    const Bounds3& b = meshBounds_[mesh];
+    Bounds3 padded{b.lo - Vec3(1, 1, 1) * epsilon_, b.hi + Vec3(1, 1, 1) * epsilon_};
+    if (b.empty() || !padded.intersect(ray, 0.0, Infinity, &t0, &t1)) return Infinity;
+    return t1;
 }
 
 MediumStack Scene::stackAt(const Vec3& p) const {

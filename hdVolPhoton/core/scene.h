@@ -101,6 +101,10 @@ public:
     bool intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit) const;
     /// Media along a segment: the unbounded ones plus the innermost interior medium of the stack.
     MediumAggregate mediaFor(const MediumStack& stack) const;
+    /// Where `ray` leaves the world bounds of mesh `mesh` (infinity when it does not meet them). A
+    /// path inside a mesh that finds no surface ahead has escaped through a hole in it (an open or
+    /// broken mesh): its medium ends here rather than extending to infinity.
+    double exitDistance(int mesh, const Ray& ray) const;
     /// Stack of closed dielectric/boundary meshes containing p, found by parity along a probe ray.
     MediumStack stackAt(const Vec3& p) const;
 
@@ -129,6 +133,7 @@ private:
     RTCScene top_ = nullptr;
     std::vector<RTCScene> meshScenes_;
     std::vector<Affine> instanceInverse_;
+    std::vector<Bounds3> meshBounds_;  ///< world bounds of each mesh over its instances
     bool hasMedia_ = false, emissiveMedia_ = false;
     Vec3 center_;
     double radius_ = 1, epsilon_ = 1e-6;

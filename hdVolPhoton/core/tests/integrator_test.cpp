@@ -532,6 +532,8 @@ TEST(IntegratorAgreement, ScatteringEmissiveMedium) {
         auto a = imageMean(d, pt, [aov](const Film& f) { return aovMean(f, aov); });
         auto b = imageMean(d, pm, [aov](const Film& f) { return aovMean(f, aov); });
         EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_) + 0.02 * a.mean) << "aov " << aov;
-        if (aov == Film::Multiple) EXPECT_GT(a.mean, 0.0);
+        if (aov == Film::Multiple) {
+            EXPECT_GT(a.mean, 0.0);
+        }
     }
 }

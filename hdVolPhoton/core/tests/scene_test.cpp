@@ -275,3 +275,38 @@ TEST(SceneCamera, FarClipHidesGeometryNotTheEnvironment) {
         for (float v : r.film().resolveRgb(Film::Beauty)) EXPECT_FLOAT_EQ(v, 0.5f);
     }
 }
+
+TEST(SceneMedia, OpenMeshMediumIsCutAtItsBoundsNotInfinite) {
+    // A fog cube with one face missing: paths leave through the hole. Neither integrator may crash
+    // or wander an infinite medium; the medium ends at the mesh's bounding box and the dome shows.
+    SceneDesc d;
+    MeshDesc cube;
+    cube.name = "openCube";
+    for (int z : {-1, 1})
+        for (int y : {-1, 1})
+            for (int x : {-1, 1}) cube.points.push_back(Vec3(x, y, z));
+    cube.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6};  // no +x face
+    cube.material.kind = SurfaceMaterial::Kind::Boundary;
+    cube.interiorMedium = 0;
+    d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase())));
+    d.meshes.push_back(cube);
+    d.instances.push_back({0, Affine()});
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    d.camera.cameraToWorld = Affine::translate(Vec3(0.3, 0.2, 5));
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        RenderSettings s;
+        s.integrator = integrator;
+        s.width = s.height = 16;
+        s.samplesPerPixel = 4;
+        s.photonsPerPass = 2000;
+        Renderer r(std::make_shared<Scene>(d), s);
+        r.render();
+        double sum = 0;
+        for (float v : r.film().resolveRgb(Film::Beauty)) {
+            ASSERT_TRUE(std::isfinite(v));
+            sum += v;
+        }
+        // A non-absorbing-ish fog in a dome: the image is bright, not black from lost paths.
+        EXPECT_GT(sum / (16 * 16 * 3), 0.5);
+    }
+}
