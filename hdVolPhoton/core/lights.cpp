@@ -139,6 +139,7 @@ public:
     }
     bool isDelta() const override { return r_ == 0; }
     std::optional<Vec3> pointPosition() const override { return r_ == 0 ? std::optional<Vec3>(p_) : std::nullopt; }
+    std::optional<Vec3> equiangularCenter() const override { return p_; }
     Spectrum power(double) const override {
         // Point: 4 pi I; sphere: pi L * 4 pi r^2. Spot shaping scales by the cone's solid-angle share,
         // approximated by its hard cone (used for light selection and photon budgets only).

@@ -49,6 +49,8 @@ public:
     virtual bool isDelta() const = 0;
     /// Position of a point (or point spot) light, for equiangular sampling; nullopt for others.
     virtual std::optional<Vec3> pointPosition() const { return std::nullopt; }
+    /// Centre towards which equiangular sampling aims (point, spot and sphere lights); nullopt for others.
+    virtual std::optional<Vec3> equiangularCenter() const { return std::nullopt; }
     /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
     virtual Spectrum power(double sceneRadius) const = 0;
     virtual PhotonEmission emitPhoton(const Vec3& sceneCenter, double sceneRadius, double u[4]) const = 0;

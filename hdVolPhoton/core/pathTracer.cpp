@@ -9,10 +9,12 @@
 // collision as beta * emission / sigma_maj (pbrt-v4's VolPathIntegrator does the same).
 // Direct light: next-event estimation with shadow transmittance (closed form where the media have one,
 // else ratio tracking), combined with phase/BSDF sampling by MIS (power heuristic) for lights with
-// extent. Point and spot lights (delta) add a second strategy on every segment in a medium:
-// equiangular sampling of the distance (Kulla and Fajardo 2012), combined with the NEE at real
-// collisions by one-sample MIS (balance heuristic) against the free-flight density.
-// XXX: sphere lights with a radius use NEE + phase MIS only, not equiangular sampling.
+// extent. Point, spot and sphere lights add a second strategy on every segment in a medium:
+// equiangular sampling of the distance towards the light's centre (Kulla and Fajardo 2012),
+// combined with the NEE at real collisions by one-sample MIS over distance (balance heuristic
+// against the free-flight density). For sphere lights the light-sampled half of the direction MIS
+// is split between the two distance strategies and the phase-sampled half stays with free flights,
+// so every (distance, direction) pair's weights still sum to one.
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
 
@@ -25,7 +27,7 @@ class PathTracer final : public Integrator {
 public:
     PathTracer(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
         for (const LightPtr& l : scene.lights()) {
-            std::optional<Vec3> position = l->pointPosition();
+            std::optional<Vec3> position = l->equiangularCenter();
             pointLight_.push_back(position.has_value());
             pointLightPosition_.push_back(position.value_or(Vec3()));
             hasPointLights_ |= position.has_value();
@@ -125,11 +127,11 @@ public:
                         Spectrum T = shadowTransmittance(p, ds.ls.wi, ds.ls.dist, stack, rng);
                         double lightDensity = ds.pickProb * ds.ls.pdf;
                         double w = ds.ls.isDelta ? 1.0 : powerHeuristic(lightDensity, mp.scatterPdf(cosTheta));
-                        if (isPointLight(ds.light)) {  // MIS with the equiangular strategy of this segment
+                        if (isPointLight(ds.light)) {  // MIS over distance with the equiangular strategy
                             double tLocal = scatter.t - mediumFrom;
                             double pd = distanceDensity(media, local, tLocal);
                             double pe = equiangularPdf(ds.light, local, support, tLocal);
-                            w = pd / (pd + pe);
+                            w *= pd / (pd + pe);
                         }
                         add(beta * f * T * ds.ls.Li * (w / lightDensity), firstVertex);
                     }
@@ -275,7 +277,10 @@ private:
         if (Tcam.isBlack()) return {};
         Spectrum Tsh = shadowTransmittance(p, ls.wi, ls.dist, stack, rng);
         double pd = distanceDensity(media, ray, t);
+        // Distance MIS against free flights; for a sphere light also the direction MIS against phase
+        // sampling, which (from distance-sampled vertices only) still covers its half of each pair.
         double w = pe / (pe + pd);
+        if (!ls.isDelta) w *= powerHeuristic(pick * ls.pdf, mp.scatterPdf(dot(ray.d, ls.wi)));
         return beta * Tcam * f * Tsh * ls.Li * (w / (pick * ls.pdf * pe));
     }
 
