@@ -257,7 +257,13 @@ private:
         if (!tr.closedForm && !stop) r.T = exp(-tauRun);
         if (single)
             for (int light : pointLights_) r.single += equiangular(light, media, ray, supportStart, std::min(supportEnd, length), tr, stack, rng);
-        if (map_) r.multiple = gather(ray, supportStart, std::min(supportEnd, length), tr, stack);
+        // The beam reaches a radius past the medium's ends: photons just inside an interface project
+        // onto the ray just outside it, and dropping them loses energy wherever the source term is
+        // concentrated at the interface (a dense slab's skin); kept, the kernel only blurs it.
+        if (map_) {
+            double beam = map_->radius();
+            r.multiple = gather(ray, std::max(0.0, supportStart - beam), std::min(length, supportEnd + beam), tr, stack);
+        }
         return r;
     }
 
