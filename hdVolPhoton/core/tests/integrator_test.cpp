@@ -598,3 +598,24 @@ TEST(IntegratorSingleScattering, SphereLightEquiangularAgreesWithPhotonMap) {
     EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_));
     EXPECT_GT(a.mean, 0.0);
 }
+
+TEST(IntegratorCancel, CancelStopsTilesAndPhotonBatches) {
+    // The callback is polled per tile and per photon batch: a cancel after a few polls stops the
+    // render early and the stats say so. Tiles finished in the cancelled pass keep their sample (each
+    // pixel resolves by its own count), so counts are `passes` or `passes + 1`.
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        RenderSettings s = smallSettings(integrator, 1000, 0);
+        s.width = s.height = 64;
+        s.photonsPerPass = 50000;
+        Renderer r(std::make_shared<Scene>(mediaOnlyScene()), s);
+        std::atomic<int> polls{0};
+        RenderStats stats = r.render({}, [&]() { return ++polls > 40; });
+        EXPECT_TRUE(stats.cancelled);
+        EXPECT_LT(stats.passes, 1000);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                uint32_t n = r.film().samples(x, y);
+                EXPECT_TRUE(n == static_cast<uint32_t>(stats.passes) || n == static_cast<uint32_t>(stats.passes) + 1);
+            }
+    }
+}
