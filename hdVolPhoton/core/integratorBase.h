@@ -25,6 +25,36 @@ struct SurfaceScatter {
     bool crossed = false;  ///< the path went through the surface (refraction or boundary)
 };
 
+/// The ray a camera path follows: surfaces are searched in [tMin, tMax] (tMax is the camera's far
+/// clip, or infinity after a bounce) and media are tracked from mediumFrom (the near clip on the
+/// camera ray, the vertex itself after it).
+struct PathRay {
+    Ray ray;
+    double tMin, tMax, mediumFrom;
+
+    /// Straight on through an index-matched boundary met at distance t (the far clip still counts).
+    void passBoundary(const SurfaceScatter& s, double t) {
+        ray = s.next;
+        tMin = s.tMin;
+        mediumFrom = 0;
+        if (!std::isinf(tMax)) tMax -= t;
+    }
+    /// Out of a broken (open) medium mesh through a hole at distance t: the path is outside it now.
+    void leaveHole(MediumStack& stack, double t) {
+        stack.toggle(stack.innermost());
+        ray = {ray.at(t), ray.d};
+        tMin = mediumFrom = 0;
+        if (!std::isinf(tMax)) tMax -= t;
+    }
+    /// A new direction from a vertex (a medium event or a surface).
+    void bounce(const Ray& next, double nextTMin) {
+        ray = next;
+        tMin = nextTMin;
+        mediumFrom = 0;
+        tMax = Infinity;
+    }
+};
+
 /// \class Integrator
 /// Camera-path estimator. beginPass() runs once per pass before the camera samples (the photon pass);
 /// Li() is called concurrently from render threads and must be const.

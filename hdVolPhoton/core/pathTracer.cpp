@@ -34,9 +34,10 @@ public:
         }
     }
 
-    PathRadiance Li(const Ray& cameraRay, double tMin, double tMax, Rng& rng) const override {
+    PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
         PathRadiance out;
-        Ray ray = cameraRay;
+        PathRay path{cameraRay, nearClip, farClip, nearClip};
+        auto& [ray, tMin, tMax, mediumFrom] = path;
         Spectrum beta(1.0);
         MediumStack stack = cameraStack_;
         Branch branch = Branch::Undecided;
@@ -45,7 +46,6 @@ public:
         int depth = 0, crossings = 0;
         bool firstSegment = true;
         bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
-        double mediumFrom = tMin;       // media start at the camera's near plane, then at each vertex
 
         auto add = [&](const Spectrum& L, bool singleCandidate) {
             if (branch == Branch::Undecided) out.surface += L;  // lights/environment seen directly
@@ -144,19 +144,14 @@ public:
                 beta *= mp.scatterKernel(cosTheta) / pdf;
                 prevPdf = pdf;
                 specular = false;
-                ray = {p, w};
-                tMin = mediumFrom = 0;
-                tMax = Infinity;
+                path.bounce({p, w}, 0.0);
                 firstSegment = false;
                 lightHitIsSingle = firstVertex;
                 if (!roulette(beta, depth, rng)) break;
                 continue;
             }
             if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
-                stack.toggle(stack.innermost());
-                ray = {ray.at(leakExit), ray.d};
-                tMin = mediumFrom = 0;
-                tMax = std::isinf(tMax) ? tMax : tMax - leakExit;
+                path.leaveHole(stack, leakExit);
                 continue;
             }
             bool lightWasSingle = lightHitIsSingle;
@@ -173,11 +168,7 @@ public:
             const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
             if (m.kind == SurfaceMaterial::Kind::Boundary) {
                 if (++crossings > 256) break;
-                SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
-                ray = s.next;
-                tMin = s.tMin;
-                mediumFrom = 0;
-                tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
+                path.passBoundary(scatterSurface(ray, hit, stack, rng, true), hit.t);
                 continue;
             }
             if (branch == Branch::Undecided) branch = Branch::Surface;
@@ -191,10 +182,7 @@ public:
             beta *= s.weight;
             specular = s.type == SurfaceScatter::Type::Specular;
             if (!specular) prevPdf = std::abs(dot(s.next.d, hit.ns)) * InvPi;
-            ray = s.next;
-            tMin = s.tMin;
-            mediumFrom = 0;
-            tMax = Infinity;
+            path.bounce(s.next, s.tMin);
             firstSegment = false;
             if (!roulette(beta, depth, rng)) break;
         }

@@ -81,14 +81,14 @@ public:
         return true;
     }
 
-    PathRadiance Li(const Ray& cameraRay, double tMin, double tMax, Rng& rng) const override {
+    PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
         PathRadiance out;
-        Ray ray = cameraRay;
+        PathRay path{cameraRay, nearClip, farClip, nearClip};
+        auto& [ray, tMin, tMax, mediumFrom] = path;
         Spectrum beta(1.0);
         MediumStack stack = cameraStack_;
         bool firstSegment = true, onlySpecular = true;
         int depth = 0, crossings = 0;
-        double mediumFrom = tMin;  // media start at the camera's near plane, then at each vertex
         // Which AOV a contribution goes to: the first non-boundary vertex decides (integrator.h).
         auto route = [&](Spectrum& medium) -> Spectrum& { return firstSegment ? medium : out.surface; };
 
@@ -123,10 +123,7 @@ public:
             beta *= Tseg;
             if (beta.isBlack()) break;
             if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
-                stack.toggle(stack.innermost());
-                ray = {ray.at(leakExit), ray.d};
-                tMin = mediumFrom = 0;
-                tMax = std::isinf(tMax) ? tMax : tMax - leakExit;
+                path.leaveHole(stack, leakExit);
                 continue;
             }
             if (hasLight && (!hasHit || tLight <= hit.t)) {
@@ -141,11 +138,7 @@ public:
             const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
             if (m.kind == SurfaceMaterial::Kind::Boundary) {
                 if (++crossings > 256) break;
-                SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
-                ray = s.next;
-                tMin = s.tMin;
-                mediumFrom = 0;
-                tMax = std::isinf(tMax) ? tMax : tMax - hit.t;
+                path.passBoundary(scatterSurface(ray, hit, stack, rng, true), hit.t);
                 continue;
             }
             firstSegment = false;
@@ -158,10 +151,7 @@ public:
             if (s.type == SurfaceScatter::Type::Absorbed) break;
             beta *= s.weight;
             onlySpecular = onlySpecular && s.type == SurfaceScatter::Type::Specular;
-            ray = s.next;
-            tMin = s.tMin;
-            mediumFrom = 0;
-            tMax = Infinity;
+            path.bounce(s.next, s.tMin);
             if (depth >= settings_.rouletteDepth) {
                 double q = std::max(0.0, 1 - beta.maxValue());
                 if (rng.uniform() < q) break;
