@@ -37,12 +37,27 @@ inline double invertMajorantDepth(double tau, double sigma, double decay) {
     return x == 0 ? s : s * (-std::log1p(-x) / x);
 }
 
+/// How a free flight ended.
+enum class FlightEnd {
+    Escaped,    ///< reached tMax
+    Stopped,    ///< the callback returned false (a real scattering or absorption)
+    Truncated,  ///< gave up after MaxTentativeCollisions: treat as opaque (see below)
+};
+
+/// Upper bound on tentative collisions in one flight. A loose majorant over an enormous density (a
+/// VDB of 1e7 or 3e38 voxels next to empty ones) would otherwise take billions of steps: a hang on
+/// bad input. Past it the flight is declared opaque, which biases only such pathological media;
+/// warnTruncatedFlight() says so the first time.
+constexpr int64_t MaxTentativeCollisions = int64_t(1) << 20;
+void warnTruncatedFlight();
+
 /// Draws tentative collisions along ray over (0, tMax) through `medium`'s majorants, calling
 /// callback(const MediumEvent&) -> bool at each, in increasing t. The callback returns false to stop
-/// (a real scattering or absorption). Returns true when the ray reached tMax without being stopped.
+/// (a real scattering or absorption).
 template <typename Callback>
-bool sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback) {
-    bool reachedEnd = true;
+FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback) {
+    FlightEnd end = FlightEnd::Escaped;
+    int64_t events = 0;
     medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
         double t = seg.tMin;
         double sigma = seg.sigmaMaj;
@@ -50,16 +65,21 @@ bool sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rn
             double tau = -std::log1p(-rng.uniform());  // Exp(1); uniform() < 1 keeps it finite
             double dt = invertMajorantDepth(tau, sigma, seg.decay);
             if (!(dt < seg.tMax - t)) return true;  // passed the segment: on to the next one
+            if (++events > MaxTentativeCollisions) {
+                warnTruncatedFlight();
+                end = FlightEnd::Truncated;
+                return false;
+            }
             t += dt;
             if (seg.decay != 0) sigma = std::min(seg.sigmaMaj * std::exp(-seg.decay * (t - seg.tMin)), 1e300);
             MediumEvent event{t, ray.at(t), medium.properties(ray.at(t)), sigma};
             if (!callback(event)) {
-                reachedEnd = false;
+                end = FlightEnd::Stopped;
                 return false;
             }
         }
     });
-    return reachedEnd;
+    return end;
 }
 
 }  // namespace volphoton

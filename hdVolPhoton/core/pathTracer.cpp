@@ -85,7 +85,7 @@ public:
                         if (branch == Branch::Undecided) out.single += L;
                         else add(L, false);
                     }
-                    sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
+                    FlightEnd end = sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
                         if (emissive && !e.mp.emission.isBlack()) {
                             Spectrum L = beta * e.mp.emission / e.sigmaMaj;
                             if (branch == Branch::Undecided) out.emission += L;
@@ -108,6 +108,7 @@ public:
                         beta *= sigma_n * (total / (e.sigmaMaj * pn));
                         return true;
                     });
+                    absorbed |= end == FlightEnd::Truncated;
                 }
             }
             if (absorbed) break;

@@ -407,7 +407,7 @@ private:
             MediumEvent ev{};
             MediumAggregate media = scene_.mediaFor(stack);
             if (media.size()) {
-                sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
+                FlightEnd end = sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
                     Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
                     for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
                     double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
@@ -419,6 +419,7 @@ private:
                     flux *= sigma_n * (total / (m.sigmaMaj * pn));
                     return true;
                 });
+                absorbed |= end == FlightEnd::Truncated;
             }
             if (absorbed) return;
             if (scattered) {

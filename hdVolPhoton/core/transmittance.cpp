@@ -2,7 +2,19 @@
 
 #include "core/freeFlight.h"
 
+#include <atomic>
+
+#include "core/diagnostics.h"
+
 namespace volphoton {
+
+void warnTruncatedFlight() {
+    static std::atomic<bool> warned{false};
+    if (!warned.exchange(true))
+        warn("a free flight met over " + std::to_string(MaxTentativeCollisions) +
+             " tentative collisions (a medium far denser than its majorant grid resolves, e.g. extreme "
+             "voxel values); such flights are treated as opaque");
+}
 
 Spectrum transmittance(const Medium& medium, const Ray& ray, double tMax, Rng& rng,
                        const TransmittanceSettings& settings) {
@@ -26,7 +38,7 @@ Spectrum transmittance(const Medium& medium, const Ray& ray, double tMax, Rng& r
 Spectrum ratioTrackingTransmittance(const Medium& medium, const Ray& ray, double tMax, Rng& rng,
                                     const TransmittanceSettings& settings) {
     Spectrum T(1.0);
-    sampleFreeFlight(medium, ray, tMax, rng, [&](const MediumEvent& e) {
+    FlightEnd end = sampleFreeFlight(medium, ray, tMax, rng, [&](const MediumEvent& e) {
         Spectrum sigma_t = e.mp.sigma_t();
         for (int c = 0; c < 3; ++c) T[c] *= std::max(0.0, 1.0 - sigma_t[c] / e.sigmaMaj);
         double Tmax = T.maxValue();
@@ -44,7 +56,7 @@ Spectrum ratioTrackingTransmittance(const Medium& medium, const Ray& ray, double
         }
         return true;
     });
-    return T;
+    return end == FlightEnd::Truncated ? Spectrum(0.0) : T;
 }
 
 Spectrum marchedTransmittance(const Medium& medium, const Ray& ray, double tMax, Rng& rng, double step) {

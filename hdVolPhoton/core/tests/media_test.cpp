@@ -185,7 +185,7 @@ TEST(MediaFreeFlight, ExponentialClosedFormAndEscape) {
     const int n = 200000;
     int escaped = 0, beforeOne = 0, nonReal = 0;
     for (int i = 0; i < n; ++i) {
-        bool reached = sampleFreeFlight(m, r, Infinity, rng, [&](const MediumEvent& e) {
+        bool reached = FlightEnd::Escaped == sampleFreeFlight(m, r, Infinity, rng, [&](const MediumEvent& e) {
             if (e.mp.sigma_t()[0] < e.sigmaMaj * (1 - 1e-9)) nonReal++;
             if (e.t < 1.0) beforeOne++;
             return false;
@@ -306,4 +306,31 @@ TEST(MediaTransmittance, RatioTrackingIsUnbiasedOnVdb) {
             EXPECT_NEAR(est.mean, exact[ch], K * est.stderr_ + 1e-4) << "channel " << ch;  // 1e-4: quadrature error
         }
     }
+}
+
+namespace {
+/// A medium whose majorant is 1e12 but whose density is 0: every tentative collision is null.
+class LooseMajorant final : public Medium {
+public:
+    MediumProperties properties(const Vec3&) const override { return {}; }
+    void majorants(const Ray&, double tMin, double tMax, MajorantCallback segment) const override {
+        segment(MajorantSegment{tMin, std::min(tMax, 1.0), 1e12, 0.0});
+    }
+    Bounds3 bounds() const override { return {Vec3(-1, -1, -1), Vec3(1, 1, 1)}; }
+    bool isEmissive() const override { return false; }
+    double maxAlbedo() const override { return 0; }
+    std::string describe() const override { return "loose"; }
+};
+}  // namespace
+
+TEST(MediaFreeFlight, HopelesslyLooseMajorantsEndInsteadOfHanging) {
+    LooseMajorant m;
+    Rng rng(1);
+    int events = 0;
+    FlightEnd end = sampleFreeFlight(m, {Vec3(), Vec3(1, 0, 0)}, 1.0, rng, [&](const MediumEvent&) { ++events; return true; });
+    EXPECT_EQ(end, FlightEnd::Truncated);
+    EXPECT_EQ(events, MaxTentativeCollisions);
+    TransmittanceSettings s;
+    s.mode = TransmittanceMode::RatioTracking;
+    EXPECT_EQ(transmittance(m, {Vec3(), Vec3(1, 0, 0)}, 1.0, rng, s)[0], 0.0);
 }
