@@ -85,35 +85,9 @@ class Run:
         return True, out
 
 
-def run_with_rusage(cmd, timeout, cwd):
-    """-> (exit code or -signal, hung, stdout, stderr, peak RSS of that child in MB)."""
-    import threading
-
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=cwd)
-    out, err = [b""], [b""]
-    readers = [threading.Thread(target=lambda: out.__setitem__(0, proc.stdout.read())),
-               threading.Thread(target=lambda: err.__setitem__(0, proc.stderr.read()))]
-    for t in readers:
-        t.start()
-    deadline = time.monotonic() + timeout
-    hung = False
-    while True:
-        pid, status, ru = os.wait4(proc.pid, os.WNOHANG)
-        if pid:
-            break
-        if time.monotonic() > deadline:
-            hung = True
-            proc.kill()
-            pid, status, ru = os.wait4(proc.pid, 0)
-            break
-        time.sleep(0.02)
-    code = -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
-    proc.returncode = code
-    for t in readers:
-        t.join()
-    proc.stdout.close()
-    proc.stderr.close()
-    return code, hung, out[0].decode(errors="replace"), err[0].decode(errors="replace"), ru.ru_maxrss / 1024.0
+# One subprocess runner (timeout, signal, peak RSS) for the benchmarks and the stress suite.
+sys.path.insert(0, os.path.dirname(HERE))
+from stress import run_with_rusage  # noqa: E402
 
 
 # --------------------------------------------------------------------------------------------------
