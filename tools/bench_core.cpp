@@ -110,6 +110,27 @@ int main(int argc, char** argv) {
     benchMedium("aggregate homog + exp", both, Vec3(), 2.0, n);
     std::printf("\n(closed form falls back to ratio tracking for the grid)\n");
 
+    std::printf("\n## Grid cost against grid size (the same cloud shape, 2 scene units wide, at finer voxels)\n\n");
+    std::printf("| resolution | active voxels | majorant build (ms) | ns per ratio-tracking query |\n|---|---|---|---|\n");
+    for (int res : {32, 64, 128, quick ? 128 : 256}) {
+        std::string p = "/tmp/volphoton_bench_cloud_" + std::to_string(res) + ".vdb";
+        writeProceduralCloudVdb(p, res, 2.0 / res, 1);
+        GridMediumDesc d;
+        d.filePath = p;
+        d.densityScale = 4.0;
+        auto g = loadGridMedium(d);
+        Bounds3 gb = g->bounds();
+        Vec3 gc = (gb.lo + gb.hi) * 0.5;
+        Rng rng(4);
+        std::vector<Ray> rays;
+        for (int i = 0; i < 1024; ++i) rays.push_back(randomRay(rng, gc, 2.0));
+        TransmittanceSettings ratio;
+        ratio.mode = TransmittanceMode::RatioTracking;
+        double ns = nsPer(n / 4, [&](int i) { sink = transmittance(*g, rays[i & 1023], 4.0, rng, ratio)[0]; });
+        std::printf("| %d^3 | %zu | %.1f | %.0f |\n", res, g->activeVoxelCount(), g->majorantBuildSeconds() * 1e3, ns);
+        if (quick && res == 128) break;
+    }
+
     std::printf("\n## Grid cost against bounding-box size, data fixed (two blobs)\n\n");
     std::printf("| separation (voxels) | box voxels   | ns/ray, rays through the empty middle | ns/ray through a blob |\n");
     std::printf("|---------------------|--------------|---------------------------------------|-----------------------|\n");
