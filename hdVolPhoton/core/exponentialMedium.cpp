@@ -17,7 +17,9 @@ double oneMinusExpOverX(double x) {
 
 double exponentialOpticalDepth(double a, double b, double h0, double mu, double s) {
     // tau = int_0^s a e^{-b (h0 + mu t)} dt = a e^{-b h0} s (1 - e^{-b mu s}) / (b mu s)
-    double start = a * std::exp(std::min(-b * h0, MaxExponent));
+    // a e^{-b h0} in log space, so a huge a with a large exponent cannot overflow to inf (and inf * 0
+    // to NaN further on); a = 0 gives log 0 = -inf, hence 0.
+    double start = std::exp(std::min(std::log(a) - b * h0, MaxExponent));
     double x = b * mu * s;
     if (x < -MaxExponent) return Infinity;  // the path dives far below h0: opaque
     return start * s * oneMinusExpOverX(x);
@@ -37,7 +39,9 @@ ExponentialMedium::ExponentialMedium(const MediumCoefficients& c, double a, doub
 
 double ExponentialMedium::relativeDensity(const Vec3& p) const {
     double h = dot(p - origin_, up_);
-    return a_ * std::exp(std::min(-b_ * h, MaxExponent));
+    // Capped so that sigma_t itself stays finite (<= 1e300): beyond that the medium is opaque anyway.
+    double cap = std::min(MaxExponent, std::log(1e300 / std::max(1.0, sigmaMaxChannel_)));
+    return std::exp(std::min(std::log(a_) - b_ * h, cap));
 }
 
 MediumProperties ExponentialMedium::properties(const Vec3& p) const {

@@ -207,25 +207,27 @@ private:
         media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
             supportStart = std::min(supportStart, seg.tMin);
             supportEnd = std::max(supportEnd, seg.tMax);
-            // Steps of at most step_; an unbounded segment (an atmosphere, fog around the camera) is
-            // marched for at most MaxSteps steps, by which the early termination below has usually
-            // ended it. XXX: a thin unbounded medium beyond MaxSteps * step_ is not marched.
-            constexpr double MaxSteps = 1e5;
-            // A step also resolves the segment's mean free path, so thick media are marched finely
-            // enough for the camera transmittance and thin ones cost few steps.
-            double len = seg.tMax - seg.tMin;
-            double stepHere = std::min(step_, 0.25 / seg.sigmaMaj);
-            int n = static_cast<int>(std::clamp(std::ceil(len / stepHere), 1.0, MaxSteps));
-            double dt = std::min(len / n, stepHere);
-            for (int i = 0; i < n && !stop; ++i) {
-                double t = seg.tMin + (i + offsetU) * dt;
+            // Steps of at most step_ that also resolve the local mean free path (a quarter of it,
+            // from the majorant at the step's far end, so a ray descending into a steep exponential
+            // atmosphere shortens its steps as the density grows); each step is sampled at the same
+            // jittered fraction offsetU. An unbounded segment is marched for at most MaxSteps steps,
+            // by which the early termination below has usually ended it.
+            // XXX: a thin unbounded medium beyond MaxSteps steps is not marched.
+            constexpr int MaxSteps = 100000;
+            double t0 = seg.tMin;
+            for (int i = 0; i < MaxSteps && t0 < seg.tMax && !stop; ++i) {
+                double sigmaHere = seg.decay == 0 ? seg.sigmaMaj : seg.sigmaMaj * std::exp(std::min(-seg.decay * (t0 - seg.tMin), 700.0));
+                double dt = std::min({step_, 0.25 / sigmaHere, seg.tMax - t0});
+                if (seg.decay < 0) dt = std::min(dt, 0.25 / (sigmaHere * std::exp(std::min(-seg.decay * dt, 700.0))));
+                double t = t0 + offsetU * dt;
+                t0 += dt;
                 Vec3 p = ray.at(t);
                 MediumProperties mp = media.properties(p);
                 Spectrum sigma_t = mp.sigma_t();
                 Spectrum T = tr.closedForm ? tr.at(t) : exp(-(tauRun + sigma_t * (offsetU * dt)));
                 if (!tr.closedForm) {
                     tauRun += sigma_t * dt;
-                    tr.t.push_back(seg.tMin + (i + 1) * dt);
+                    tr.t.push_back(t0);
                     for (int c = 0; c < 3; ++c) tr.tau[c].push_back(tauRun[c]);
                 }
                 if (!sigma_t.isBlack()) r.interacted = true;
@@ -495,23 +497,24 @@ private:
         }
     }
 
-    /// Keeps the photon map within the memory budget: each photon survives with probability
-    /// p = budget / size and its power is divided by p, so the estimate stays unbiased.
+    /// Keeps the photon map within the memory budget: exactly `budget` photons survive, chosen
+    /// uniformly without replacement (a partial Fisher-Yates shuffle with a seeded stream), and
+    /// their power is scaled by size / budget, so the estimate stays unbiased.
     uint64_t thinToBudget(int pass, std::vector<Photon>* photons) const {
         size_t maxPhotons = std::max<size_t>(1, settings_.photonMapBudgetBytes / PhotonMap::BytesPerPhoton);
-        if (photons->size() <= maxPhotons) return 0;
-        double p = static_cast<double>(maxPhotons) / photons->size();
+        size_t n = photons->size();
+        if (n <= maxPhotons) return 0;
         Rng rng(hashKeys(0x5448494eULL, settings_.seed, pass));
-        size_t kept = 0;
-        for (const Photon& ph : *photons) {
-            if (rng.uniform() >= p) continue;
-            Photon q = ph;
-            for (float& c : q.power) c = static_cast<float>(c / p);
-            (*photons)[kept++] = q;
+        for (size_t i = 0; i < maxPhotons; ++i) {
+            size_t j = i + std::min(n - i - 1, static_cast<size_t>(rng.uniform() * (n - i)));
+            std::swap((*photons)[i], (*photons)[j]);
         }
-        uint64_t dropped = photons->size() - kept;
-        photons->resize(kept);
+        double scale = static_cast<double>(n) / maxPhotons;
+        photons->resize(maxPhotons);
         photons->shrink_to_fit();
+        for (Photon& ph : *photons)
+            for (float& c : ph.power) c = static_cast<float>(c * scale);
+        uint64_t dropped = n - maxPhotons;
         static std::atomic<bool> warned{false};
         if (!warned.exchange(true))
             warn("photon map over its budget of " + std::to_string(settings_.photonMapBudgetBytes >> 20) + " MiB: " +

@@ -321,7 +321,7 @@ TEST(IntegratorSemiInfinite, ChandrasekharDiffuseAlbedo) {
             RenderSettings ps;
             ps.integrator = RenderSettings::Integrator::PhotonMap;
             ps.maxDepth = 100000;
-            ps.photonsPerPass = w > 0.95 ? 40000 : 150000;
+            ps.photonsPerPass = w > 0.95 ? 60000 : 150000;
             ps.initialRadius = 0.02;
             ps.seed = seed;
             auto pm = makePhotonMapper(pmScene, ps);
@@ -549,7 +549,7 @@ TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
     Renderer r(std::make_shared<Scene>(d), capped);
     r.render();
     EXPECT_GT(r.stats().photonsThinned, 0u);
-    EXPECT_LE(r.stats().photonMapBytes, capped.photonMapBudgetBytes * 2);
+    EXPECT_LE(r.stats().photonMapBytes, capped.photonMapBudgetBytes);  // exactly within the budget
 }
 
 TEST(IntegratorAgreement, ScatteringEmissiveMedium) {

@@ -334,3 +334,20 @@ TEST(MediaFreeFlight, HopelesslyLooseMajorantsEndInsteadOfHanging) {
     s.mode = TransmittanceMode::RatioTracking;
     EXPECT_EQ(transmittance(m, {Vec3(), Vec3(1, 0, 0)}, 1.0, rng, s)[0], 0.0);
 }
+
+TEST(MediaStress, HugeExponentialDensitiesStayFinite) {
+    // a = b = 1e6 with a tilted up axis: a e^{-b h} overflows double unless computed in log space.
+    ExponentialMedium m(grey(1e7, 1.0), 1e6, 1e6, Vec3(0, 0, 0), normalize(Vec3(0.3, 1, 0.1)));
+    for (double y : {-1.0, -1e-3, 0.0, 1e-3, 1.0}) {
+        MediumProperties mp = m.properties(Vec3(0.1, y, 0.2));
+        EXPECT_TRUE(mp.sigma_t().isFinite() && mp.sigma_s.isFinite() && mp.scatterKernel(0.3).isFinite()) << y;
+    }
+    Rng rng(2);
+    for (Vec3 d : {Vec3(0, -1, 0), Vec3(0, 1, 0), normalize(Vec3(1, 0.01, 0))}) {
+        Ray r{Vec3(0, 0.5, 0), d};
+        EXPECT_TRUE(transmittance(m, r, 2.0, rng).isFinite());
+        EXPECT_TRUE(std::isfinite(exponentialOpticalDepth(1e6, 1e6, -0.5, -0.5, 1.0)) ||
+                    std::isinf(exponentialOpticalDepth(1e6, 1e6, -0.5, -0.5, 1.0)));  // +inf is opaque, never NaN
+        EXPECT_FALSE(std::isnan(exponentialOpticalDepth(1e6, 1e6, -0.5, -0.5, 1.0)));
+    }
+}
