@@ -8,10 +8,14 @@
 #include "core/homogeneousMedium.h"
 #include "core/integratorBase.h"
 #include "core/photonMap.h"
+#include "tests/renderTestUtil.h"
 #include "tests/testUtil.h"
 
 using namespace volphoton;
 using volphoton::test::meanAndError;
+using volphoton::test::aovMean;
+using volphoton::test::imageMean;
+using volphoton::test::smallSettings;
 
 namespace {
 constexpr int Seeds = 16;
@@ -31,17 +35,6 @@ CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov = 0.6) 
     return c;
 }
 
-RenderSettings smallSettings(RenderSettings::Integrator integrator, int spp, uint64_t seed) {
-    RenderSettings s;
-    s.integrator = integrator;
-    s.width = s.height = 8;
-    s.samplesPerPixel = spp;
-    s.seed = seed;
-    s.maxDepth = 1000;
-    s.photonsPerPass = 4000;
-    s.initialRadius = 0.05;
-    return s;
-}
 
 /// Renders one image per seed and returns per-pixel beauty channel c (or an AOV) for each seed.
 std::vector<std::vector<float>> renderSeeds(const std::function<SceneDesc()>& makeScene, RenderSettings s, Film::Aov aov = Film::Beauty,
@@ -358,24 +351,6 @@ SceneDesc mediaOnlyScene() {
     return d;
 }
 
-test::MeanAndError imageMean(const SceneDesc& desc, RenderSettings s, const std::function<double(const Film&)>& statistic) {
-    auto scene = std::make_shared<Scene>(desc);
-    std::vector<double> xs;
-    for (int seed = 0; seed < Seeds; ++seed) {
-        s.seed = seed;
-        Renderer r(scene, s);
-        r.render();
-        xs.push_back(statistic(r.film()));
-    }
-    return meanAndError(xs);
-}
-
-double aovMean(const Film& f, Film::Aov aov) {
-    auto v = f.resolveRgb(aov);
-    double s = 0;
-    for (float x : v) s += x;
-    return s / v.size();
-}
 }  // namespace
 
 TEST(IntegratorAgreement, PhotonSinglePlusMultipleEqualsPathTracerBeauty) {

@@ -4,6 +4,7 @@
 
 #include "core/homogeneousMedium.h"
 #include "core/integratorBase.h"
+#include "tests/renderTestUtil.h"
 #include "tests/testUtil.h"
 
 using namespace volphoton;
@@ -140,25 +141,10 @@ TEST(SceneCamera, PerspectiveOrthographicAndDepthOfField) {
 namespace {
 /// Mean over a small image, per seed.
 test::MeanAndError furnaceMean(const SceneDesc& d, RenderSettings::Integrator integrator, int spp = 16) {
-    auto scene = std::make_shared<Scene>(d);
-    std::vector<double> xs;
-    for (int seed = 0; seed < 16; ++seed) {
-        RenderSettings s;
-        s.integrator = integrator;
-        s.width = s.height = 8;
-        s.samplesPerPixel = spp;
-        s.seed = seed;
-        s.maxDepth = 1000;
-        s.photonsPerPass = 8000;
-        s.initialRadius = 0.1;
-        Renderer r(scene, s);
-        r.render();
-        auto v = r.film().resolveRgb(Film::Beauty);
-        double sum = 0;
-        for (size_t i = 0; i < v.size(); i += 3) sum += v[i];
-        xs.push_back(sum / (v.size() / 3));
-    }
-    return meanAndError(xs);
+    RenderSettings s = test::smallSettings(integrator, spp, 0);
+    s.photonsPerPass = 8000;
+    s.initialRadius = 0.1;
+    return test::imageMean(d, s, [](const Film& f) { return test::aovMean(f, Film::Beauty, 0); });
 }
 }  // namespace
 
