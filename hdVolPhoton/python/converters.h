@@ -108,5 +108,6 @@ namespace volphoton::bindings {
 
 void registerImage(pybind11::module_& m);
 void registerVdbTestHelpers(pybind11::module_& m);
+void registerGltf(pybind11::module_& m);
 
 }  // namespace volphoton::bindings

@@ -6,6 +6,7 @@ Usage
                      [--threads N] [--photons N] [--max-depth N] [--stats STATS.json]
                      [--png OUT.png | --no-png] [--display D] [--view V] [--quiet]
     volphoton check SCENE.usd [--frames A:B]     translate only; print every diagnostic
+    volphoton gltf2usd IN.gltf|IN.glb OUT.usd[a|c] [--root-name NAME]   glTF 2.0 -> USD (volphoton/gltf.py)
     volphoton --version
 
 Outputs
@@ -316,6 +317,14 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--frames", metavar="A:B")
     c.add_argument("--camera", metavar="PATH")
     c.add_argument("-v", "--verbose", action="store_true", help="also print what was translated")
+
+    g = sub.add_parser("gltf2usd", help="convert a glTF 2.0 asset (.gltf/.glb) to USD",
+                       description="Convert a glTF 2.0 asset to a USD layer a stage can reference. Exit 0: "
+                       "converted; 1: converted without the elements named in errors; 2: nothing written.")
+    g.add_argument("input", metavar="IN", help=".gltf or .glb")
+    g.add_argument("output", metavar="OUT", help=".usda (text), .usdc or .usd (crate)")
+    g.add_argument("--root-name", default="", metavar="NAME", help="default prim name (default: from IN's name)")
+    g.add_argument("-q", "--quiet", action="store_true", help="no summary (diagnostics still print)")
     return ap
 
 
@@ -624,12 +633,33 @@ def cmd_check(args) -> int:
         core.set_diagnostic_sink(None)
 
 
+def cmd_gltf2usd(args) -> int:
+    register_usd_plugin(include_source_tree=True)
+    from . import gltf
+    start = _time.time()
+    try:
+        result = gltf.convert(args.input, args.output, args.root_name)
+    except gltf.GltfError as e:
+        sys.stderr.write("volphoton: error: %s\n" % e)
+        return EXIT_USAGE
+    for d in result.diagnostics:
+        sys.stderr.write("volphoton: %s\n" % gltf.format_diagnostic(args.input, d))
+    if not args.quiet:
+        s = result.stats
+        print("volphoton: wrote %s: %d nodes, %d meshes, %d triangles in %.2f s%s"
+              % (args.output, s["node_prims"], s["mesh_prims"], s["triangles"], _time.time() - start,
+                 " (%d errors)" % len(result.errors) if result.errors else ""))
+    return EXIT_FAILURE if result.errors else EXIT_OK
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)  # exits with status 2 on usage errors
     try:
         if args.command == "render":
             return cmd_render(args)
+        if args.command == "gltf2usd":
+            return cmd_gltf2usd(args)
         return cmd_check(args)
     except UsageError as e:
         sys.stderr.write("volphoton: error: %s\n" % e)
