@@ -37,4 +37,5 @@ echo "setup: building the C++ core, its tests and tools in build/"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build
 [ -f testenv/cloud.vdb ] || python tools/make_cloud_vdb.py testenv/cloud.vdb
+python tools/make_gltf_assets.py testenv/gltf >/dev/null   # the glTF example asset, converted
 echo "setup: done. Activate with: . .venv/bin/activate"

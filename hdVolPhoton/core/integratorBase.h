@@ -94,7 +94,7 @@ protected:
     /// the origin instead skipped a layer of medium, which matters when the mean free path is
     /// below the epsilon.
     double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
-        return scene_.epsilon() / std::max(std::abs(dot(w, hit.ng)), 1e-2);
+        return scene_.epsilon() / std::max(std::abs(dot(w, hit.ng)), 0.1);
     }
 
     const Scene& scene_;

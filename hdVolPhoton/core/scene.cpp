@@ -18,6 +18,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     if (!device_) throw std::runtime_error("cannot create an Embree device");
     rtcSetDeviceErrorFunction(device_, embreeError, nullptr);
     top_ = rtcNewScene(device_);
+    rtcSetSceneFlags(top_, RTC_SCENE_FLAG_ROBUST);
 
     for (auto& m : desc_.media)
         if (!m) throw std::invalid_argument("scene: null medium");
@@ -36,6 +37,9 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         if (m.interiorMedium >= static_cast<int>(desc_.media.size()))
             throw std::invalid_argument("mesh '" + m.name + "': interior medium index out of range");
         RTCScene s = rtcNewScene(device_);
+        // Watertight ray/triangle tests: without ROBUST, a ray through a shared edge can miss both
+        // triangles, and a path inside a closed medium mesh walks out through the "hole".
+        rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
         float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.points.size()));
         for (size_t i = 0; i < m.points.size(); ++i) {

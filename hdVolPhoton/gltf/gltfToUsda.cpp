@@ -542,7 +542,11 @@ bool Translator::buildMesh(int meshIndex, MeshBuild& mesh) {
 }
 
 void Translator::writeMesh(int meshIndex, const MeshBuild& mesh, int depth, const std::string& primName) {
-    _w.openPrim(depth, "def Mesh", primName, gltfNameMetadata(_model.meshes[meshIndex].name));
+    const std::set<int> materials(mesh.faceMaterial.begin(), mesh.faceMaterial.end());
+    const bool primBinding = materials.size() == 1 && *materials.begin() >= 0;
+    std::vector<std::string> metadata = gltfNameMetadata(_model.meshes[meshIndex].name);
+    if (primBinding) metadata.push_back("prepend apiSchemas = [\"MaterialBindingAPI\"]");
+    _w.openPrim(depth, "def Mesh", primName, metadata);
     const int d = depth + 1;
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (std::size_t i = 0; i < mesh.points.size(); ++i) {
@@ -557,7 +561,6 @@ void Translator::writeMesh(int meshIndex, const MeshBuild& mesh, int depth, cons
     if (!mesh.st.empty()) _w.array(d, "texCoord2f[] primvars:st", mesh.st, 2, "vertex");
 
     // displayColor: vertex colours when every primitive has COLOR_0, else the materials' base colours.
-    std::set<int> materials(mesh.faceMaterial.begin(), mesh.faceMaterial.end());
     auto baseColor = [&](int material, float rgba[4]) {
         std::vector<double> f = material >= 0 ? _model.materials[material].pbrMetallicRoughness.baseColorFactor
                                               : std::vector<double>{1, 1, 1, 1};
@@ -592,7 +595,7 @@ void Translator::writeMesh(int meshIndex, const MeshBuild& mesh, int depth, cons
     _w.line(d, "uniform token subdivisionScheme = \"none\"");
 
     // Materials: one binding for the prim, or a partition of GeomSubsets when primitives differ.
-    if (materials.size() == 1 && *materials.begin() >= 0) {
+    if (primBinding) {
         _w.line(d, "rel material:binding = <" + materialPath(*materials.begin()) + ">");
     } else if (materials.size() > 1) {
         _w.line(d, "uniform token subsetFamily:materialBind:familyType = \"partition\"");
