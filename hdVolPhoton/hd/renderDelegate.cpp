@@ -13,6 +13,7 @@
 #include "hd/renderBuffer.h"
 #include "hd/renderParam.h"
 #include "hd/renderPass.h"
+#include "hd/renderSettings.h"
 #include "hd/volume.h"
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -35,7 +36,7 @@ TfTokenVector const &_Sprims() {
     return v;
 }
 TfTokenVector const &_Bprims() {
-    static TfTokenVector v = {HdPrimTypeTokens->renderBuffer, _OpenvdbAsset()};
+    static TfTokenVector v = {HdPrimTypeTokens->renderBuffer, HdPrimTypeTokens->renderSettings, _OpenvdbAsset()};
     return v;
 }
 bool _IsLight(TfToken const &t) {
@@ -104,6 +105,7 @@ TfTokenVector const &HdVolPhotonRenderDelegate::GetSupportedSprimTypes() const {
 TfTokenVector const &HdVolPhotonRenderDelegate::GetSupportedBprimTypes() const { return _Bprims(); }
 HdResourceRegistrySharedPtr HdVolPhotonRenderDelegate::GetResourceRegistry() const { return _resourceRegistry; }
 HdRenderSettingDescriptorList HdVolPhotonRenderDelegate::GetRenderSettingDescriptors() const { return _settingDescriptors; }
+TfTokenVector HdVolPhotonRenderDelegate::GetRenderSettingsNamespaces() const { return {TfToken("volphoton")}; }
 
 VtDictionary HdVolPhotonRenderDelegate::GetRenderStats() const {
     VtDictionary stats = _renderer.GetStats();
@@ -164,12 +166,14 @@ void HdVolPhotonRenderDelegate::DestroySprim(HdSprim *sPrim) { delete sPrim; }
 HdBprim *HdVolPhotonRenderDelegate::CreateBprim(TfToken const &typeId, SdfPath const &bprimId) {
     if (typeId == HdPrimTypeTokens->renderBuffer) return new HdVolPhotonRenderBuffer(bprimId);
     if (typeId == _OpenvdbAsset()) return new HdVolPhotonField(bprimId);
+    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(bprimId, this);
     TF_CODING_ERROR("hdVolPhoton: unknown bprim type %s", typeId.GetText());
     return nullptr;
 }
 HdBprim *HdVolPhotonRenderDelegate::CreateFallbackBprim(TfToken const &typeId) {
     if (typeId == HdPrimTypeTokens->renderBuffer) return new HdVolPhotonRenderBuffer(SdfPath::EmptyPath());
     if (typeId == _OpenvdbAsset()) return new HdVolPhotonField(SdfPath::EmptyPath());
+    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(SdfPath::EmptyPath(), this);
     return nullptr;
 }
 void HdVolPhotonRenderDelegate::DestroyBprim(HdBprim *bPrim) { delete bPrim; }

@@ -61,6 +61,8 @@ public:
     TfTokenVector const &GetSupportedBprimTypes() const override;
     HdResourceRegistrySharedPtr GetResourceRegistry() const override;
     HdRenderSettingDescriptorList GetRenderSettingDescriptors() const override;
+    /// "volphoton": the UsdRender settings attributes HdVolPhotonRenderSettings receives.
+    TfTokenVector GetRenderSettingsNamespaces() const override;
     VtDictionary GetRenderStats() const override;
     bool IsPauseSupported() const override { return true; }
     bool Pause() override;

@@ -163,6 +163,23 @@ def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) ->
             _set(prim, Sdf, "volphoton:exponential:up", Sdf.ValueTypeNames.Vector3f, Gf.Vec3f(0, 1, 0))
             _set(prim, Sdf, "volphoton:bounds:min", Sdf.ValueTypeNames.Point3f, Gf.Vec3f(*m.lo))
             _set(prim, Sdf, "volphoton:bounds:max", Sdf.ValueTypeNames.Point3f, Gf.Vec3f(*m.hi))
+        elif isinstance(m, S.TranslucentMesh):
+            mesh = UsdGeom.Mesh.Define(stage, "/World/" + m.name)
+            mesh.CreatePointsAttr([Gf.Vec3f(*map(float, p)) for p in m.points])
+            mesh.CreateFaceVertexCountsAttr([3] * len(m.tris))
+            mesh.CreateFaceVertexIndicesAttr([int(i) for i in np.asarray(m.tris).reshape(-1)])
+            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            prim = mesh.GetPrim()
+            _apply_medium_api(prim, Sdf)
+            _set(prim, Sdf, "volphoton:ior", Sdf.ValueTypeNames.Float, float(m.ior))
+            density = max(m.sigma_t)
+            _set(prim, Sdf, "volphoton:density", Sdf.ValueTypeNames.Float, float(density))
+            _set(prim, Sdf, "volphoton:extinctionColor", Sdf.ValueTypeNames.Color3f,
+                 Gf.Vec3f(*[float(c / density) for c in m.sigma_t]))
+            _set(prim, Sdf, "volphoton:albedo", Sdf.ValueTypeNames.Color3f, Gf.Vec3f(*map(float, m.albedo)))
+            _set(prim, Sdf, "volphoton:densityMode", Sdf.ValueTypeNames.Token, "constant", uniform=True)
+            _phase(prim, Sdf, m.phase)
+            _xform(UsdGeom, Gf, prim, m.to_world)
         else:
             raise TypeError(m)
 

@@ -9,6 +9,9 @@ Variant llvm_ad_rgb (needs Debian's libllvm19), else scalar_rgb.  Mapping from t
     * camera: perspective, fov_axis x, look_at(eye, target, up), box reconstruction filter of radius
       0.5 px (uniform samples inside each pixel, as volphoton), hdrfilm rgb float32, linear;
     * lambertian meshes -> PLY + diffuse; media boxes -> PLY + null BSDF + interior medium;
+    * translucent meshes -> PLY + dielectric BSDF (int_ior, ext_ior 1) + interior homogeneous medium
+      with RGB sigma_t and albedo (volpath samples distances per channel, as volphoton's spectral
+      tracking does);
     * grid media -> heterogeneous medium over a gridvolume of the VDB's voxels (exported by
       ours.py voxels through volphoton's own GridMedium), trilinear, placed so that voxel centres
       coincide with OpenVDB's; exponential media -> heterogeneous medium over an RGB gridvolume of
@@ -154,6 +157,14 @@ def build_dict(mi, scene: S.BenchScene, width: int, height: int, spp: int, workd
                                     "interior": {"type": "ref", "id": "medium_" + m.name}}
             if np.all(np.array(cam.eye) > lo) and np.all(np.array(cam.eye) < hi):
                 camera_medium = "medium_" + m.name
+        elif isinstance(m, S.TranslucentMesh):
+            med = {"type": "homogeneous", "sigma_t": _rgb(m.sigma_t), "albedo": _rgb(m.albedo), "phase": _phase(m.phase)}
+            d["medium_" + m.name] = med
+            d["shape_" + m.name] = {"type": "ply", "filename": write_ply(os.path.join(workdir, m.name + ".ply"),
+                                                                          m.points, m.tris),
+                                    "face_normals": True, "to_world": T(m.to_world),
+                                    "bsdf": {"type": "dielectric", "int_ior": float(m.ior), "ext_ior": 1.0},
+                                    "interior": {"type": "ref", "id": "medium_" + m.name}}
         else:
             raise TypeError(m)
     if camera_medium:

@@ -1,0 +1,42 @@
+// hdVolPhoton: the UsdRender settings prim.
+#ifndef HDVOLPHOTON_RENDER_SETTINGS_H
+#define HDVOLPHOTON_RENDER_SETTINGS_H
+
+#include "pxr/pxr.h"
+#include "pxr/imaging/hd/renderSettings.h"
+
+PXR_NAMESPACE_OPEN_SCOPE
+
+class HdRenderDelegate;
+
+/// \class HdVolPhotonRenderSettings
+///
+/// The Bprim of a UsdRenderSettings prim (scene-index imaging: usdrecord/usdview with
+/// `--renderSettingsPrimPath` or an active settings prim). When it is the active one, its
+/// `volphoton:*` attributes (the namespaced settings Hydra filters with the delegate's
+/// GetRenderSettingsNamespaces) become the delegate's render settings, with the same names and
+/// meanings as the standalone front end reads from the same prim:
+///
+/// | RenderSettings attribute     | delegate setting                                  |
+/// |------------------------------|---------------------------------------------------|
+/// | volphoton:samplesPerPixel    | convergedSamplesPerPixel (HdRenderSettingsTokens) |
+/// | volphoton:threads            | threadLimit (HdRenderSettingsTokens)              |
+/// | volphoton:<other>            | volphoton:<other> (see renderDelegate.h's table)  |
+///
+/// SetRenderSetting bumps the delegate's settings version, so the render pass restarts.
+/// Threading: Sync runs on Hydra's sync thread; it only calls SetRenderSetting.
+class HdVolPhotonRenderSettings final : public HdRenderSettings
+{
+public:
+    HdVolPhotonRenderSettings(SdfPath const &id, HdRenderDelegate *delegate);
+
+protected:
+    void _Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *renderParam, HdDirtyBits const *dirtyBits) override;
+
+private:
+    HdRenderDelegate *_delegate;
+};
+
+PXR_NAMESPACE_CLOSE_SCOPE
+
+#endif  // HDVOLPHOTON_RENDER_SETTINGS_H

@@ -1,0 +1,132 @@
+"""The delegate with glTF assets (the Sdf file-format plug-in) and with broken scenes."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from hydra_util import REPO, TESTENV, run_usdrecord
+
+from volphoton import output  # noqa: E402
+
+
+def rgb(path):
+    channels, _ = output.read_exr(path)
+    return np.stack([channels[c] for c in "RGB"], axis=-1)
+
+
+def make_assets(tmp_path):
+    p = subprocess.run([sys.executable, os.path.join(REPO, "tools", "make_gltf_assets.py"), str(tmp_path / "gltf")],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stdout + p.stderr
+
+
+def test_glb_reference_renders_like_the_converted_usdc(tmp_path, hydra_env):
+    """`references = @gltf/statue.glb@` goes through the plug-in, which runs the same translator as
+    gltf2usd: same prims, same seed -> the same picture as the converted .usdc."""
+    make_assets(tmp_path)
+    scene = open(os.path.join(TESTENV, "gltf_statue.usda")).read()
+    scene = scene.replace("int2 resolution = (160, 90)", "int2 resolution = (48, 27)")
+    scene = scene.replace("int volphoton:samplesPerPixel = 16", "int volphoton:samplesPerPixel = 2")
+    assert "@gltf/statue.usdc@" in scene
+    (tmp_path / "usdc.usda").write_text(scene)
+    (tmp_path / "glb.usda").write_text(scene.replace("@gltf/statue.usdc@", "@gltf/statue.glb@"))
+    images = []
+    for name in ("usdc", "glb"):
+        out = str(tmp_path / (name + ".exr"))
+        r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility",
+                                      str(tmp_path / (name + ".usda")), out])
+        assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
+        images.append(rgb(out))
+    assert np.isfinite(images[0]).all() and images[0].mean() > 0
+    assert np.array_equal(images[0], images[1])
+
+
+def test_openusd_opens_a_glb_as_a_stage(tmp_path, hydra_env):
+    make_assets(tmp_path)
+    code = ("from pxr import Usd, UsdGeom\n"
+            "s = Usd.Stage.Open(%r)\n"
+            "print(UsdGeom.GetStageUpAxis(s), UsdGeom.GetStageMetersPerUnit(s))\n"
+            "print(sorted(str(p.GetPath()) for p in s.Traverse() if p.IsA(UsdGeom.Mesh)))\n"
+            % str(tmp_path / "gltf" / "statue.glb"))
+    usdrecord_python = open(hydra_env["usdrecord"]).readline()[2:].strip()  # usdrecord's #! interpreter
+    p = subprocess.run([usdrecord_python, "-c", code], capture_output=True, text=True, env=hydra_env["env"],
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert "Y 1.0" in p.stdout
+    assert "/statue/Statue/figure/figure" in p.stdout and "/statue/Statue/pedestal/pedestal" in p.stdout
+
+
+BROKEN = '''#usda 1.0
+(
+    defaultPrim = "World"
+    upAxis = "Y"
+    renderSettingsPrimPath = "/Render/settings"
+)
+def Scope "Render"
+{
+    def RenderSettings "settings"
+    {
+        int2 resolution = (32, 18)
+        rel camera = </World/camera>
+        int volphoton:samplesPerPixel = 2
+    }
+}
+def Xform "World"
+{
+    def Camera "camera"
+    {
+        double3 xformOp:translate = (0, 0, 8)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+    def Volume "missingVdb" (prepend apiSchemas = ["VolPhotonMediumAPI"])
+    {
+        rel field:density = </World/missingVdb/density>
+        def OpenVDBAsset "density"
+        {
+            asset filePath = @./no_such_file.vdb@
+            token fieldName = "density"
+        }
+    }
+    def Volume "wrongField" (prepend apiSchemas = ["VolPhotonMediumAPI"])
+    {
+        rel field:density = </World/wrongField/density>
+        def OpenVDBAsset "density"
+        {
+            asset filePath = @%(vdb)s@
+            token fieldName = "no_such_grid"
+        }
+    }
+    def Sphere "nanXform"
+    {
+        double3 xformOp:translate = (nan, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+    def Sphere "fine"
+    {
+        double radius = 1
+    }
+    def DomeLight "sky"
+    {
+        float inputs:intensity = 1
+    }
+}
+'''
+
+
+def test_broken_scene_warns_naming_prims_and_still_renders(tmp_path, hydra_env):
+    vdb = os.path.join(TESTENV, "cloud.vdb")
+    assert os.path.exists(vdb), "tools/setup.sh writes testenv/cloud.vdb"
+    (tmp_path / "broken.usda").write_text(BROKEN % {"vdb": vdb})
+    out = str(tmp_path / "broken.exr")
+    for scene_index in (True, False):
+        r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility",
+                                      str(tmp_path / "broken.usda"), out], scene_index=scene_index)
+        log = r.stdout + r.stderr
+        assert r.returncode == 0 and os.path.exists(out), log
+        for prim in ("/World/missingVdb", "/World/wrongField", "/World/nanXform"):
+            assert prim in log, (scene_index, prim, log)
+        image = rgb(out)
+        assert np.isfinite(image).all() and image.max() > 0  # the dome and the fine sphere still render
+        os.remove(out)
