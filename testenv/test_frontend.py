@@ -907,6 +907,26 @@ def test_wrong_field_name_and_wrong_grid_type(tmp_path, cloud_vdb):
     assert r.returncode == 0, r.stderr
 
 
+def test_grid_size_cap_refuses_large_grids_by_option_and_by_render_settings(tmp_path, cloud_vdb):
+    """The grid-size cap (issue #6): a grid with more active voxels than the cap is an error naming the
+    field's prim, the file, the count and the cap; the rest of the scene renders. The cloud has ~1e5
+    active voxels."""
+    r, out = render_bad(tmp_path, VOLUME_SCENE % (str(cloud_vdb), "density"), "--max-grid-voxels", "1000")
+    assert r.returncode == 1
+    err = one_line_error(r)
+    assert "/cloud/density" in err and "grid-size cap of 1000" in err and "active voxels" in err, err
+    assert_clean_image(out)
+    capped = VOLUME_SCENE + """
+    def RenderSettings "rs" { int64 volphoton:maxGridVoxels = 1000 }
+"""
+    r, out = render_bad(tmp_path, capped % (str(cloud_vdb), "density"))
+    assert r.returncode == 1 and "grid-size cap of 1000" in r.stderr, r.stderr
+    r, out = render_bad(tmp_path, capped % (str(cloud_vdb), "density"), "--max-grid-voxels", "0")  # 0: no cap
+    assert r.returncode == 0, r.stderr
+    r, out = render_bad(tmp_path, VOLUME_SCENE % (str(cloud_vdb), "density"))  # the default cap: 2^30
+    assert r.returncode == 0, r.stderr
+
+
 def test_nan_xform_negative_density_and_unknown_token(tmp_path):
     r, out = render_bad(tmp_path, """
         def Camera "cam" { double3 xformOp:translate = (0, 0, 5)

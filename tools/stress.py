@@ -996,9 +996,11 @@ KNOWN_ISSUES = [
      "~1e39 null collisions per unit length; the render never ends (1e6 already takes 6 s for 96 paths)"),
     (lambda c, w, m: c.get("kind") == "exponential" and max(c.get("a", 0), c.get("b", 0)) >= 1e6 and "photonMap" in w
      and "furnace" in m,
-     "photonMap energy gain in extreme exponential media (a or b = 1e6): the single-scattering march is "
-     "right (early passes ~0.55 L) but some photon passes reach 1.5-136 L in the white furnace; the path "
-     "tracer stays <= 1 L"),
+     "photonMap energy gain in extreme exponential media (a or b = 1e6): the mean free path at the medium's "
+     "surface (1e-6) is far below the beam radius (auto: 1/100 of the scene), so photons stored just inside "
+     "the opaque layer are gathered by camera segments passing within the radius outside it, with the "
+     "camera transmittance of the segment (~1), not of the photon; white furnace 1.5-45 L. The path tracer "
+     "stays <= 1 L. (A clamped-density majorant bug that also gained energy here is fixed.)"),
 ]
 
 

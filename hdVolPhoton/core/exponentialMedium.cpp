@@ -37,11 +37,14 @@ ExponentialMedium::ExponentialMedium(const MediumCoefficients& c, double a, doub
     sigmaMaxChannel_ = c_.sigma_t().maxValue();
 }
 
+double ExponentialMedium::densityCapExponent() const {
+    // Capped so that sigma_t itself stays finite (<= 1e300): beyond that the medium is opaque anyway.
+    return std::min(MaxExponent, std::log(1e300 / std::max(1.0, sigmaMaxChannel_)));
+}
+
 double ExponentialMedium::relativeDensity(const Vec3& p) const {
     double h = dot(p - origin_, up_);
-    // Capped so that sigma_t itself stays finite (<= 1e300): beyond that the medium is opaque anyway.
-    double cap = std::min(MaxExponent, std::log(1e300 / std::max(1.0, sigmaMaxChannel_)));
-    return std::exp(std::min(std::log(a_) - b_ * h, cap));
+    return std::exp(std::min(std::log(a_) - b_ * h, densityCapExponent()));
 }
 
 MediumProperties ExponentialMedium::properties(const Vec3& p) const {
@@ -58,11 +61,31 @@ MediumProperties ExponentialMedium::properties(const Vec3& p) const {
 // sigma_max a e^{-b h(t)} = sigmaMaj e^{-b mu (t - t0)}: a decaying segment. For grey media it equals
 // sigma_t, so every tentative collision is real and free flights are sampled in closed form by
 // inverting tau (see freeFlight.h); chromatic media see null collisions only in the thinner channels.
+// Where relativeDensity() clamps (log density above densityCapExponent()), the density is flat, so
+// that part of the ray gets a constant segment: a decaying majorant there would fall below the
+// clamped density and every event would gain energy (sigma_t / sigma_maj > 1 per event).
 void ExponentialMedium::majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const {
     double t0, t1;
     if (sigmaMaxChannel_ == 0 || a_ == 0 || !bounds_.intersect(ray, tMin, tMax, &t0, &t1)) return;
-    double start = sigmaMaxChannel_ * relativeDensity(ray.at(t0));
-    segment(MajorantSegment{t0, t1, start, b_ * dot(ray.d, up_)});
+    const double cap = densityCapExponent();
+    const double decay = b_ * dot(ray.d, up_);                                // d(log density)/dt = -decay
+    const double log0 = std::log(a_) - b_ * dot(ray.at(t0) - origin_, up_);  // unclamped, at t0
+    auto emit = [&](double ta, double tb, bool clamped, double logStart) {
+        if (clamped) segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(cap), 0.0});
+        else segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(std::min(logStart, cap)), decay});
+    };
+    const double tCross = decay != 0 ? t0 + (log0 - cap) / decay : Infinity;  // log density = cap there
+    if (tCross > t0 && tCross < t1) {
+        if (decay > 0) {  // thinning along the ray: clamped, then decaying from the cap
+            emit(t0, tCross, true, cap);
+            emit(tCross, t1, false, cap);
+        } else {  // thickening: growing up to the cap, then clamped
+            emit(t0, tCross, false, log0);
+            emit(tCross, t1, true, cap);
+        }
+        return;
+    }
+    emit(t0, t1, log0 > cap, log0);
 }
 
 std::optional<Spectrum> ExponentialMedium::opticalDepth(const Ray& ray, double t0, double t1) const {

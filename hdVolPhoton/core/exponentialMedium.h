@@ -36,6 +36,8 @@ public:
 
     /// Relative density a e^{-b h} at p, with the exponent clamped so it stays finite.
     double relativeDensity(const Vec3& p) const;
+    /// log of the largest relative density: beyond it the density is clamped (sigma_t <= 1e300).
+    double densityCapExponent() const;
 
 private:
     MediumCoefficients c_;

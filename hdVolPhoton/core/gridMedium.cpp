@@ -774,8 +774,22 @@ std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc) {
                 if (!any) msg << " none";
                 throw GridLoadError(msg.str());
             }
+            auto overCap = [&](std::uint64_t voxels, const char* how) {
+                return GridLoadError("grid " + quote(name) + " (" + role + ") in VDB file " + quote(path) + " has " +
+                                     std::to_string(voxels) + " active voxels (" + how + "), more than the grid-size cap of " +
+                                     std::to_string(desc.maxActiveVoxels) +
+                                     " (volphoton:maxGridVoxels on the RenderSettings prim, or --max-grid-voxels)");
+            };
+            if (desc.maxActiveVoxels > 0) {
+                openvdb::MetaMap::Ptr meta = file.readGridMetadata(name);
+                if (auto count = meta ? meta->getMetadata<openvdb::Int64Metadata>("file_voxel_count") : nullptr;
+                    count && count->value() > 0 && std::uint64_t(count->value()) > desc.maxActiveVoxels)
+                    throw overCap(std::uint64_t(count->value()), "recorded in the file");
+            }
             openvdb::GridBase::Ptr g = file.readGrid(name);
             if (!g) throw GridLoadError("VDB file " + quote(path) + ": could not read " + reading);
+            if (desc.maxActiveVoxels > 0 && g->activeVoxelCount() > desc.maxActiveVoxels)
+                throw overCap(g->activeVoxelCount(), "counted after reading");
             if (!g->isType<FloatGrid>())
                 throw GridLoadError("grid " + quote(name) + " (" + role + ") in VDB file " + quote(path) +
                                     " has value type " + g->valueType() + " (grid type " + g->type() +

@@ -68,6 +68,11 @@ struct GridMediumDesc {
     double temperatureScale = 1.0;
     PhasePtr phase;  ///< null = isotropic
     Affine objectToWorld;
+    /// Grid-size cap: a grid with more active voxels is refused before its tree is read when the
+    /// file records its voxel count (OpenVDB's "file_voxel_count" metadata), else right after.
+    /// 2^30 float voxels are about 4 GiB plus the tree; 0 = no cap.
+    std::uint64_t maxActiveVoxels = kDefaultMaxGridVoxels;
+    static constexpr std::uint64_t kDefaultMaxGridVoxels = std::uint64_t(1) << 30;
 };
 
 /// In-memory grids for the GridMedium constructor; each must be an openvdb::FloatGrid with a linear

@@ -347,6 +347,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("emission_grid", &GridMediumDesc::emissionGrid)
         .def_readwrite("albedo_grid", &GridMediumDesc::albedoGrid)
         .def_readwrite("density_scale", &GridMediumDesc::densityScale)
+        .def_readwrite("max_active_voxels", &GridMediumDesc::maxActiveVoxels)
         .def_readwrite("extinction_color", &GridMediumDesc::extinctionColor)
         .def_readwrite("albedo", &GridMediumDesc::albedo)
         .def_readwrite("emission", &GridMediumDesc::emission)
@@ -364,6 +365,7 @@ PYBIND11_MODULE(_core, m) {
         .def("majorant_build_seconds", &GridMedium::majorantBuildSeconds)
         .def_property_readonly("world_to_index", &GridMedium::worldToIndex)
         .def_property_readonly("index_to_world", &GridMedium::indexToWorld);
+    m.attr("DEFAULT_MAX_GRID_VOXELS") = GridMediumDesc::kDefaultMaxGridVoxels;
     m.def("load_grid_medium", [](const GridMediumDesc& desc) {
         GridMediumDesc copy = desc;
         py::gil_scoped_release release;

@@ -53,6 +53,34 @@ TEST(MediaExponential, OpticalDepthAlongRayMatchesQuadrature) {
     EXPECT_NEAR(tau / q, 1.0, 1e-8);
 }
 
+TEST(MediaExponential, MajorantBoundsTheClampedDensity) {
+    // a = b = 1e6: below h = (ln a - cap) / b the density is clamped (flat). The majorant must bound
+    // sigma_t everywhere along rays that start in, end in or cross the clamped part; a decaying
+    // majorant started inside it fell below the flat density (the photon-map energy gain of stress
+    // cases 259-262).
+    ExponentialMedium m(grey(1.0), 1e6, 1e6, Vec3(), Vec3(0, 1, 0), Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)});
+    const double hCap = (std::log(1e6) - m.densityCapExponent()) / 1e6;
+    ASSERT_LT(hCap, 0.0);
+    for (Vec3 dir : {Vec3(0, 1, 0), Vec3(0, -1, 0), normalize(Vec3(1, 1e-4, 0)), normalize(Vec3(0.3, 0.8, 0.1)),
+                     normalize(Vec3(0.3, -0.8, 0.1))}) {
+        for (double h0 : {-0.5, hCap - 1e-9, hCap + 1e-7, 1e-5}) {
+            Ray r{Vec3(-dir.x * 0.5, h0, -dir.z * 0.5), dir};
+            int segments = 0;
+            m.majorants(r, 0.0, 2.0, [&](const MajorantSegment& seg) {
+                ++segments;
+                for (int i = 0; i <= 100; ++i) {
+                    double t = seg.tMin + (seg.tMax - seg.tMin) * i / 100.0;
+                    double maj = std::min(seg.sigmaMaj * std::exp(-seg.decay * (t - seg.tMin)), 1e300);
+                    double st = m.properties(r.at(t)).sigma_t().maxValue();
+                    EXPECT_LE(st, maj * (1 + 1e-9)) << "h0 " << h0 << " dir " << dir.y << " t " << t;
+                }
+                return true;
+            });
+            EXPECT_GE(segments, 1);
+        }
+    }
+}
+
 TEST(MediaHomogeneous, BeerLambertClosedForm) {
     HomogeneousMedium m(chromatic(Spectrum(1, 2, 0.5)));
     Rng rng(1);

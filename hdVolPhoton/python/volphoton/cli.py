@@ -304,6 +304,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--photons", type=_non_negative_int, metavar="N", help="photons per pass (photonmap)")
     r.add_argument("--max-depth", type=_non_negative_int, metavar="N", help="scattering/bounce events per path")
     r.add_argument("--stats", metavar="STATS.json", help="write render statistics as JSON")
+    r.add_argument("--max-grid-voxels", type=_non_negative_int, metavar="N",
+                   help="grid-size cap: refuse VDB grids with more active voxels (default 2^30; 0 = no cap; "
+                   "the RenderSettings prim's volphoton:maxGridVoxels otherwise)")
     png = r.add_mutually_exclusive_group()
     png.add_argument("--png", metavar="OUT.png", help="display image (default: the EXR name with .png)")
     png.add_argument("--no-png", action="store_true", help="do not write the display image")
@@ -465,7 +468,7 @@ def cmd_render(args) -> int:
         for index, (frame, tc) in enumerate(frames):
             reporter.new_frame()
             fstats = _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path,
-                                   rs_info.conform_policy, display, progress, reporter, index, len(frames))
+                                   rs_info, display, progress, reporter, index, len(frames))
             total_errors += fstats["diagnostics"]["errors"]
             run_stats["frames"].append(fstats)
             if args.stats and stats_per_frame:
@@ -486,10 +489,11 @@ def cmd_render(args) -> int:
         core.set_diagnostic_sink(None)
 
 
-def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path, policy, display,
+def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path, rs_info, display,
                   progress, reporter, index, count) -> dict:
     t0 = _time.perf_counter()
-    scene = usdscene.translate(stage, tc, settings.width, settings.height, camera_path, policy)
+    cap = args.max_grid_voxels if args.max_grid_voxels is not None else rs_info.max_grid_voxels
+    scene = usdscene.translate(stage, tc, settings.width, settings.height, camera_path, rs_info.conform_policy, cap)
     for d in _unique(scene.diagnostics):
         reporter.diagnostic(d)
     t1 = _time.perf_counter()
@@ -610,7 +614,7 @@ def cmd_check(args) -> int:
         width, height = rs_info.resolution or DEFAULT_RESOLUTION
         for frame, tc in _frame_times(stage, args.frames):
             scene = usdscene.translate(stage, tc, width, height, args.camera or rs_info.camera_path,
-                                       rs_info.conform_policy)
+                                       rs_info.conform_policy, rs_info.max_grid_voxels)
             for d in _unique(scene.diagnostics):
                 reporter.diagnostic(d)
             errors += len(scene.errors)

@@ -212,6 +212,7 @@ class RenderSettingsInfo:
     camera_path: Optional[str] = None
     conform_policy: str = "expandAperture"
     overrides: Dict[str, object] = field(default_factory=dict)  # RenderSettings field -> value
+    max_grid_voxels: Optional[int] = None  # volphoton:maxGridVoxels (grid-size cap; 0 = none)
     diagnostics: List[Diagnostic] = field(default_factory=list)
 
 
@@ -667,6 +668,7 @@ class _Translator:
         self.diags: List[Diagnostic] = []
         self.d = _Diags(self.diags)
         self.xf = UsdGeom.XformCache(time)
+        self.max_grid_voxels = int(_core.DEFAULT_MAX_GRID_VOXELS)
         self.desc = _core.SceneDesc()
         self.meshes: List[MeshRecord] = []
         self.lights: List[LightRecord] = []
@@ -959,6 +961,7 @@ class _Translator:
         gd.temperature_scale = md.temperature_scale
         gd.phase = phase_to_core(md.phase)
         gd.object_to_world = world
+        gd.max_active_voxels = self.max_grid_voxels
         problem = vdbguard.crash_check(gd.file_path, gd.density_grid)
         if problem:
             self.d.error(dens.prim_path, "filePath", "field:density of %s (file %s): %s; volume skipped"
@@ -1251,9 +1254,17 @@ def read_render_settings(stage: Usd.Stage) -> RenderSettingsInfo:
             d.error(prim.GetPath(), "volphoton:" + name, "unusable value %r; ignored" % (v,))
             continue
         info.overrides[fieldname] = value
+    cap = prim.GetAttribute("volphoton:maxGridVoxels")
+    if cap and cap.HasAuthoredValue():
+        v = cap.Get()
+        if isinstance(v, int) and not isinstance(v, bool) and v >= 0:
+            info.max_grid_voxels = int(v)
+        else:
+            d.error(prim.GetPath(), "volphoton:maxGridVoxels", "unusable value %r (a voxel count >= 0); ignored" % (v,))
     for attr in prim.GetAuthoredAttributes():
         n = attr.GetName()
-        if n.startswith("volphoton:") and n[len("volphoton:"):] not in SETTINGS_ATTRIBUTES:
+        if n.startswith("volphoton:") and n[len("volphoton:"):] not in SETTINGS_ATTRIBUTES \
+                and n != "volphoton:maxGridVoxels":
             d.warn(prim.GetPath(), n, "unknown render setting (known: %s)" % ", ".join(SETTINGS_ATTRIBUTES))
     return info
 
@@ -1358,11 +1369,15 @@ def _camera(prim: Usd.Prim, time, xf: UsdGeom.XformCache, width: int, height: in
 
 
 def translate(stage: Usd.Stage, time=Usd.TimeCode.Default(), width: int = 640, height: int = 360,
-              camera_path: Optional[str] = None, conform_policy: str = "expandAperture") -> TranslatedScene:
-    """Reads the stage at ``time`` into a core SceneDesc; see the module docstring."""
+              camera_path: Optional[str] = None, conform_policy: str = "expandAperture",
+              max_grid_voxels: Optional[int] = None) -> TranslatedScene:
+    """Reads the stage at ``time`` into a core SceneDesc; see the module docstring.  max_grid_voxels:
+    the grid-size cap (None: the core's default, 2^30 active voxels; 0: none)."""
     if not isinstance(time, Usd.TimeCode):
         time = Usd.TimeCode(time)
     tr = _Translator(stage, time)
+    if max_grid_voxels is not None:
+        tr.max_grid_voxels = int(max_grid_voxels)
     tr.run()
     bounds = None
     if np.all(np.isfinite(tr.lo)) and np.all(np.isfinite(tr.hi)):
