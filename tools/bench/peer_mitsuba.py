@@ -158,7 +158,10 @@ def build_dict(mi, scene: S.BenchScene, width: int, height: int, spp: int, workd
             if np.all(np.array(cam.eye) > lo) and np.all(np.array(cam.eye) < hi):
                 camera_medium = "medium_" + m.name
         elif isinstance(m, S.TranslucentMesh):
-            med = {"type": "homogeneous", "sigma_t": _rgb(m.sigma_t), "albedo": _rgb(m.albedo), "phase": _phase(m.phase)}
+            # sigma_t as an RGB in [0, 1] times `scale` (Mitsuba reads a plain RGB as a bounded reflectance).
+            peak = max(m.sigma_t)
+            med = {"type": "homogeneous", "sigma_t": _rgb([c / peak for c in m.sigma_t]), "scale": float(peak),
+                   "albedo": _rgb(m.albedo), "phase": _phase(m.phase)}
             d["medium_" + m.name] = med
             d["shape_" + m.name] = {"type": "ply", "filename": write_ply(os.path.join(workdir, m.name + ".ply"),
                                                                           m.points, m.tris),
