@@ -83,6 +83,9 @@ Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double di
 double Integrator::leakDistance(const MediumStack& stack, const Ray& ray) const {
     int mesh = stack.innermost();
     if (mesh < 0) return Infinity;
+    // A closed mesh has no hole: the path already crossed it unnoticed (a grazing internal reflection
+    // whose chord to the far side is shorter than the spawn offset) and is outside. Leave it here.
+    if (scene_.meshClosed(mesh)) return 0;
     static std::atomic<bool> warned{false};
     if (!warned.exchange(true))
         warn("mesh '" + scene_.mesh(mesh).name + "' bounds a medium but is not closed: rays leave it through a hole; "

@@ -40,10 +40,13 @@ struct PathRay {
         if (!std::isinf(tMax)) tMax -= t;
     }
     /// Out of a broken (open) medium mesh through a hole at distance t: the path is outside it now.
+    /// t = 0: a closed mesh crossed unnoticed (Integrator::leakDistance); the same ray goes on, with
+    /// the same surface offset, so the crossing it skipped is not met again from the wrong side.
     void leaveHole(MediumStack& stack, double t) {
         stack.toggle(stack.innermost());
+        if (t > 0) tMin = 0;
         ray = {ray.at(t), ray.d};
-        tMin = mediumFrom = 0;
+        mediumFrom = 0;
         if (!std::isinf(tMax)) tMax -= t;
     }
     /// A new direction from a vertex (a medium event or a surface).

@@ -462,10 +462,10 @@ private:
                 tMin = 0;
                 continue;
             }
-            if (!hasHit && tEnd < 1e30) {  // left a broken mesh through a hole
+            if (!hasHit && tEnd < 1e30) {  // left a broken mesh through a hole (tEnd 0: see PathRay::leaveHole)
                 stack.toggle(stack.innermost());
                 ray = {ray.at(tEnd), ray.d};
-                tMin = 0;
+                if (tEnd > 0) tMin = 0;
                 ++crossings;
                 continue;
             }

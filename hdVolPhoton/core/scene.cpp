@@ -13,6 +13,28 @@ void embreeError(void*, RTCError code, const char* str) {
 }
 }  // namespace
 
+namespace {
+/// Every undirected edge shared by exactly two triangles (a closed surface, whatever the winding).
+bool isClosedMesh(const std::vector<uint32_t>& indices) {
+    if (indices.empty()) return false;
+    std::vector<std::pair<uint32_t, uint32_t>> edges;
+    edges.reserve(indices.size());
+    for (size_t t = 0; t + 2 < indices.size(); t += 3)
+        for (int e = 0; e < 3; ++e) {
+            uint32_t a = indices[t + e], b = indices[t + (e + 1) % 3];
+            edges.emplace_back(std::min(a, b), std::max(a, b));
+        }
+    std::sort(edges.begin(), edges.end());
+    for (size_t i = 0; i < edges.size();) {
+        size_t j = i;
+        while (j < edges.size() && edges[j] == edges[i]) ++j;
+        if (j - i != 2) return false;
+        i = j;
+    }
+    return true;
+}
+}  // namespace
+
 Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw std::runtime_error("cannot create an Embree device");
@@ -36,6 +58,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         }
         if (m.interiorMedium >= static_cast<int>(desc_.media.size()))
             throw std::invalid_argument("mesh '" + m.name + "': interior medium index out of range");
+        meshClosed_.push_back(isClosedMesh(m.indices));
         RTCScene s = rtcNewScene(device_);
         // Watertight ray/triangle tests: without ROBUST, a ray through a shared edge can miss both
         // triangles, and a path inside a closed medium mesh walks out through the "hole".

@@ -110,6 +110,8 @@ public:
 
     const SceneDesc& desc() const { return desc_; }
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
+    /// Whether mesh i is topologically closed (every edge shared by exactly two triangles).
+    bool meshClosed(int i) const { return meshClosed_[i] != 0; }
     const std::vector<LightPtr>& lights() const { return desc_.lights; }
 #ifdef VOLPHOTON_NO_VOLUMES
     // Benchmark baseline (CMake option VOLPHOTON_NO_VOLUMES): media are ignored and every
@@ -137,6 +139,7 @@ private:
     bool hasMedia_ = false, emissiveMedia_ = false;
     Vec3 center_;
     double radius_ = 1, epsilon_ = 1e-6;
+    std::vector<char> meshClosed_;
 };
 
 }  // namespace volphoton
