@@ -189,6 +189,14 @@ def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) ->
             inten, col = _color_intensity(l.radiance)
             light.CreateIntensityAttr(inten)
             light.CreateColorAttr(Gf.Vec3f(*col))
+        elif isinstance(l, S.SphereLight):
+            light = UsdLux.SphereLight.Define(stage, "/World/sphere%d" % i)
+            inten, col = _color_intensity(l.radiance)  # normalize off: intensity x color = radiance
+            light.CreateIntensityAttr(inten)
+            light.CreateColorAttr(Gf.Vec3f(*col))
+            light.CreateRadiusAttr(float(l.radius))
+            light.CreateTreatAsPointAttr(False)
+            _xform(UsdGeom, Gf, light.GetPrim(), S.translate(l.position))
         elif isinstance(l, S.Distant):
             light = UsdLux.DistantLight.Define(stage, "/World/sun%d" % i)
             inten, col = _color_intensity(l.irradiance)

@@ -78,6 +78,11 @@ def _rgb(c):
     return {"type": "rgb", "value": [float(x) for x in c]}
 
 
+def _rgb_unbounded(c):
+    """An emission RGB (may exceed 1): Mitsuba's rgb spectrum accepts it for emitters."""
+    return {"type": "rgb", "value": [float(x) for x in c]}
+
+
 def _phase(p: S.Phase):
     if p.kind == "hg":
         return {"type": "hg", "g": float(p.g)}
@@ -175,6 +180,9 @@ def build_dict(mi, scene: S.BenchScene, width: int, height: int, spp: int, workd
     for i, l in enumerate(scene.lights):
         if isinstance(l, S.Dome):
             d["light%d" % i] = {"type": "constant", "radiance": _rgb(l.radiance)}
+        elif isinstance(l, S.SphereLight):
+            d["light%d" % i] = {"type": "sphere", "center": [float(x) for x in l.position], "radius": float(l.radius),
+                                "emitter": {"type": "area", "radiance": _rgb_unbounded(l.radiance)}}
         elif isinstance(l, S.Distant):
             d["light%d" % i] = {"type": "directional", "direction": [float(x) for x in l.direction],
                                 "irradiance": _rgb(l.irradiance)}

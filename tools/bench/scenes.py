@@ -241,6 +241,15 @@ class Spot:
 
 
 @dataclass
+class SphereLight:
+    """A spherical area light of uniform radiance (visible; rays can hit it, so paths that refract
+    out of a translucent object can reach it, unlike a delta light)."""
+    position: Tuple[float, float, float]
+    radius: float
+    radiance: RGB
+
+
+@dataclass
 class BenchScene:
     name: str
     title: str
@@ -420,12 +429,16 @@ def _subsurface_ball() -> BenchScene:
         camera=Camera(eye=(0.0, 0.4, 4.2), target=(0.0, 0.0, 0.0), fov_x_deg=40.0),
         media=[TranslucentMesh("ball", points, tris, np.eye(4), ior=1.3, sigma_t=(6.0, 8.0, 10.0),
                                albedo=(0.99, 0.97, 0.95), phase=Phase("isotropic"))],
-        lights=[Distant(direction=tuple(normalize((0.2, -0.5, 1.0))), irradiance=(4.0, 3.8, 3.5)),
+        # An area light, not a sun: a path tracer cannot reach a delta light through a refracting
+        # surface (shadow rays stop there, sampled directions never hit it), so with a sun the
+        # reference would miss the sunlight inside the ball that the photon map carries.
+        lights=[SphereLight(position=(-1.0, 2.5, -4.0), radius=1.0, radiance=(12.0, 11.4, 10.5)),
                 Dome((0.1, 0.1, 0.12))],
         max_depth=1000,
         photon_settings={"photons_per_pass": 20000},
         notes="a radius-1 ball (5120 triangles) of a chromatic medium, sigma_t = (6, 8, 10), albedo (0.99, 0.97, "
-              "0.95), isotropic, behind a smooth n = 1.3 surface; a sun from behind the ball and a faint sky.",
+              "0.95), isotropic, behind a smooth n = 1.3 surface; a spherical area light behind the ball and a "
+              "faint sky.",
     )
 
 
@@ -447,13 +460,13 @@ def _subsurface_bunny() -> BenchScene:
         camera=Camera(eye=(0.4, 1.7, 9.5), target=(0.4, 1.4, 0.0), fov_x_deg=32.0, near=0.1),
         media=[TranslucentMesh("bunny", np.asarray(points, float), np.asarray(tris, np.int64), np.eye(4), ior=1.3,
                                sigma_t=MARBLE_PER_CM, albedo=MARBLE_ALBEDO, phase=Phase("isotropic"))],
-        lights=[Distant(direction=tuple(normalize((-0.1, -0.6, 1.0))), irradiance=(3.0, 2.8, 2.5)),
+        lights=[SphereLight(position=(1.0, 7.0, -8.0), radius=2.0, radiance=(14.0, 13.0, 11.5)),
                 Dome((0.15, 0.15, 0.15))],
         max_depth=100000,
         photon_settings={"photons_per_pass": 4000},
         meters_per_unit=0.01,
         notes="the 3.4 cm figurine of testenv/subsurface_bunny.usda (4666 triangles) in Jensen et al. 2001's marble "
-              "(sigma_t 22-30 per cm, albedo 0.998-0.999, n = 1.3), a sun from behind and a grey sky; paths "
+              "(sigma_t 22-30 per cm, albedo 0.998-0.999, n = 1.3), a spherical area light from behind and a grey sky; paths "
               "scatter hundreds of times.",
     )
 
