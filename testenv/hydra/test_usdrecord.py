@@ -31,12 +31,13 @@ SCENES = sorted(f for f in os.listdir(TESTENV) if f.endswith(".usda"))
 def wrapper(tmp_path, scene, seed, spp=SPP, size=SIZE):
     """A stage whose root layer sublayers the scene and overrides its RenderSettings prim."""
     src = Sdf.Layer.FindOrOpen(os.path.join(TESTENV, scene))
-    settings = src.GetPrimAtPath(src.GetMetadata("renderSettingsPrimPath") if src.HasInfo("renderSettingsPrimPath")
+    root = src.pseudoRoot
+    settings = src.GetPrimAtPath(root.GetInfo("renderSettingsPrimPath") if root.HasInfo("renderSettingsPrimPath")
                                  else "/Render/settings")
     assert settings, "%s has no RenderSettings prim" % scene
     path = tmp_path / ("%s.seed%d.usda" % (scene[:-5], seed))
-    meta = {k: src.GetInfo(k) for k in ("defaultPrim", "metersPerUnit", "upAxis", "renderSettingsPrimPath")
-            if src.HasInfo(k)}
+    meta = {k: root.GetInfo(k) for k in ("defaultPrim", "metersPerUnit", "upAxis", "renderSettingsPrimPath")
+            if root.HasInfo(k)}
     meta.setdefault("renderSettingsPrimPath", str(settings.path))
     header = "\n".join("    %s = %s" % (k, ('"%s"' % v) if isinstance(v, str) else repr(v)) for k, v in meta.items())
     parts = str(settings.path).strip("/").split("/")
@@ -49,7 +50,10 @@ def wrapper(tmp_path, scene, seed, spp=SPP, size=SIZE):
     for depth in reversed(range(len(parts))):
         body += "    " * depth + "}\n"
     path.write_text('#usda 1.0\n(\n%s\n    subLayers = [@%s@]\n)\n\n%s' % (header, os.path.join(TESTENV, scene), body))
-    return str(path), str(settings.path)
+    camera = settings.relationships.get("camera")
+    targets = list(camera.targetPathList.explicitItems) if camera else []
+    assert targets, "%s: the RenderSettings prim names no camera" % scene
+    return str(path), str(settings.path), str(targets[0])
 
 
 def rgb(exr):
@@ -64,9 +68,11 @@ def render_cli(stage, out):
     return rgb(out)
 
 
-def render_hydra(hydra_env, stage, settings_path, out):
+def render_hydra(hydra_env, stage, settings_path, camera, out):
+    # usdrecord takes the image width from --imageWidth (the settings prim has no render products)
+    # and the height from the camera's aspect ratio.
     r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", settings_path, "--enableDomeLightVisibility",
-                                  stage, out])
+                                  "--camera", camera, "--imageWidth", SIZE[0], stage, out])
     assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
     return rgb(out)
 
@@ -89,9 +95,9 @@ def block_z(a, b, block=8):
 def test_usdrecord_matches_the_standalone_front_end(tmp_path, hydra_env, scene):
     cli, hyd = [], []
     for seed in SEEDS:
-        stage, settings_path = wrapper(tmp_path, scene, seed)
+        stage, settings_path, camera = wrapper(tmp_path, scene, seed)
         cli.append(render_cli(stage, str(tmp_path / ("cli%d.exr" % seed))))
-        hyd.append(render_hydra(hydra_env, stage, settings_path, str(tmp_path / ("hydra%d.exr" % seed))))
+        hyd.append(render_hydra(hydra_env, stage, settings_path, camera, str(tmp_path / ("hydra%d.exr" % seed))))
     cli, hyd = np.array(cli), np.array(hyd)
     assert cli.shape == hyd.shape, (cli.shape, hyd.shape)
     assert np.isfinite(hyd).all()

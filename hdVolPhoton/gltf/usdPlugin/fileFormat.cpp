@@ -5,7 +5,6 @@
 #include "pxr/base/tf/diagnostic.h"
 #include "pxr/base/tf/registryManager.h"
 #include "pxr/base/tf/type.h"
-#include "pxr/usd/sdf/textFileFormat.h"
 
 #include <cctype>
 #include <fstream>
@@ -42,8 +41,15 @@ bool UsdVolPhotonGltfFileFormat::Read(SdfLayer* layer, const std::string& resolv
             TF_WARN("%s: %s", where.c_str(), d.message.c_str());
     }
     if (!t.ok) return false;
-    SdfFileFormatConstPtr usda = SdfFileFormat::FindById(SdfTextFileFormatTokens->Id);
-    return usda && usda->ReadFromString(layer, t.usda);
+    // The "usda" format (UsdUsdaFileFormat, from the usd library's plug-in), not Sdf's base text
+    // format "sdf", whose magic cookie is "#sdf".
+    static const TfToken usdaId("usda");
+    SdfFileFormatConstPtr usda = SdfFileFormat::FindById(usdaId);
+    if (!usda) {
+        TF_RUNTIME_ERROR("%s: the usda file format is not registered", resolvedPath.c_str());
+        return false;
+    }
+    return usda->ReadFromString(layer, t.usda);
 }
 
 PXR_NAMESPACE_CLOSE_SCOPE
