@@ -2,6 +2,7 @@
 
 #include "pxr/base/gf/vec3f.h"
 #include "pxr/base/tf/diagnostic.h"
+#include "pxr/base/tf/stringUtils.h"
 #include "pxr/imaging/hd/sceneDelegate.h"
 #include "pxr/imaging/hd/tokens.h"
 #include "pxr/usd/sdf/assetPath.h"
@@ -10,6 +11,7 @@
 #include "hd/renderParam.h"
 
 #include <cmath>
+#include <cstring>
 
 PXR_NAMESPACE_OPEN_SCOPE
 
@@ -20,9 +22,17 @@ HdVolPhotonLight::HdVolPhotonLight(SdfPath const &id, TfToken const &lightType) 
 HdDirtyBits HdVolPhotonLight::GetInitialDirtyBitsMask() const { return AllDirty; }
 
 namespace {
+/// A light parameter by its UsdLux name. The legacy scene delegate answers to the attribute name
+/// ("inputs:intensity"); the scene-index path (24.08) to the name without the "inputs:" prefix.
+VtValue _LightParam(HdSceneDelegate *sd, SdfPath const &id, char const *name) {
+    VtValue v = sd->GetLightParamValue(id, TfToken(name));
+    if (v.IsEmpty() && std::strncmp(name, "inputs:", 7) == 0) v = sd->GetLightParamValue(id, TfToken(name + 7));
+    return v;
+}
+
 template <typename T>
 T _Param(HdSceneDelegate *sd, SdfPath const &id, char const *name, T fallback) {
-    VtValue v = sd->GetLightParamValue(id, TfToken(name));
+    VtValue v = _LightParam(sd, id, name);
     if (v.IsHolding<T>()) return v.UncheckedGet<T>();
     if (!v.IsEmpty() && v.CanCast<T>()) return v.Cast<T>().template UncheckedGet<T>();
     return fallback;
@@ -33,6 +43,13 @@ void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdD
     SdfPath const &id = GetId();
     auto &registry = static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit();
     *dirtyBits = Clean;
+    // UsdImagingGLEngine's lighting state (usdrecord's and usdview's camera "headlight", a GL-era
+    // preview light under /_UsdImaging_<renderer>_...) is not part of the scene: the standalone
+    // front end does not see it either, so the two would not render the same picture.
+    if (TfStringStartsWith(id.GetString(), "/_UsdImaging_")) {
+        registry.SetLight(id, nullptr);
+        return;
+    }
     if (!sd->GetVisible(id)) {
         registry.SetLight(id, nullptr);
         return;
@@ -81,7 +98,7 @@ void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdD
             light = rect ? makeRectLight(xf, w, h, L) : makeDiskLight(xf, r, L);
         } else if (_lightType == HdPrimTypeTokens->domeLight) {
             LatLongImage image;
-            VtValue tex = sd->GetLightParamValue(id, TfToken("inputs:texture:file"));
+            VtValue tex = _LightParam(sd, id, "inputs:texture:file");
             if (tex.IsHolding<SdfAssetPath>() && !tex.UncheckedGet<SdfAssetPath>().GetAssetPath().empty()) {
                 SdfAssetPath const &a = tex.UncheckedGet<SdfAssetPath>();
                 try {

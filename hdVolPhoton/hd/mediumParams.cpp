@@ -1,9 +1,13 @@
 #include "hd/mediumParams.h"
 
+#include "core/presets.h"
+
 #include "pxr/base/tf/diagnostic.h"
 #include "pxr/imaging/hd/sceneDelegate.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 PXR_NAMESPACE_OPEN_SCOPE
 
@@ -87,10 +91,13 @@ std::optional<HdVolPhoton_MediumParams> HdVolPhoton_ReadMediumParams(HdSceneDele
         else TF_WARN("%s.volphoton:bounds:min: bounds:min is not below bounds:max; ignored", id.GetText());
     }
     _Get(sd, id, "volphoton:preset", &p.preset);
-    if (!p.preset.IsEmpty())
-        // XXX: measured presets are applied by the usd-core front end only (volphoton/presets.py).
-        TF_WARN("%s.volphoton:preset: presets are not read by the Hydra delegate yet; using density and albedo",
-                id.GetText());
+    if (!p.preset.IsEmpty() && !volphoton::findSubsurfacePreset(p.preset.GetString())) {
+        TF_WARN("%s.volphoton:preset: unknown preset '%s' (known: %s); using density, albedo and extinctionColor",
+                id.GetText(), p.preset.GetText(), volphoton::subsurfacePresetNames().c_str());
+        p.preset = TfToken();
+    }
+    if (_Get(sd, id, "volphoton:sceneUnitsPerMm", &p.sceneUnitsPerMm))
+        p.sceneUnitsPerMm = _Clamp(id, "volphoton:sceneUnitsPerMm", p.sceneUnitsPerMm, 1e-30f, 1e30f, 1.0f);
     return p;
 }
 
@@ -119,8 +126,25 @@ volphoton::PhasePtr HdVolPhoton_BuildPhase(HdVolPhoton_MediumParams const &p, Sd
 }
 
 volphoton::MediumCoefficients HdVolPhoton_BuildCoefficients(HdVolPhoton_MediumParams const &p, SdfPath const &id) {
-    return volphoton::MediumCoefficients::fromAlbedo(p.density, _Spectrum(p.extinctionColor), _Spectrum(p.albedo),
-                                                     _Spectrum(p.emission) * p.emissionScale, HdVolPhoton_BuildPhase(p, id));
+    volphoton::PhasePtr phase = HdVolPhoton_BuildPhase(p, id);
+    volphoton::Spectrum extinction = _Spectrum(p.extinctionColor), albedo = _Spectrum(p.albedo);
+    double density = p.density;
+    if (volphoton::SubsurfacePreset const *preset = p.preset.IsEmpty() ? nullptr : volphoton::findSubsurfacePreset(p.preset.GetString())) {
+        // The measured material, as the usd-core front end maps it (volphoton/presets.py).
+        try {
+            volphoton::PresetCoefficients c = volphoton::presetCoefficients(*preset, p.sceneUnitsPerMm, phase->meanCosine());
+            volphoton::Spectrum sigma_t = c.sigma_s + c.sigma_a;
+            density = sigma_t.maxValue();
+            for (int i = 0; i < 3; ++i) {
+                extinction[i] = density > 0 ? sigma_t[i] / density : 0.0;
+                albedo[i] = sigma_t[i] > 0 ? c.sigma_s[i] / sigma_t[i] : 0.0;
+            }
+        } catch (std::exception const &e) {
+            TF_WARN("%s.volphoton:preset: %s; using density, albedo and extinctionColor", id.GetText(), e.what());
+        }
+    }
+    return volphoton::MediumCoefficients::fromAlbedo(density, extinction, albedo, _Spectrum(p.emission) * p.emissionScale,
+                                                     phase);
 }
 
 PXR_NAMESPACE_CLOSE_SCOPE

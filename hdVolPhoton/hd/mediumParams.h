@@ -37,7 +37,8 @@ struct HdVolPhoton_MediumParams {
     GfVec3f expOrigin{0.0f, 0.0f, 0.0f};
     float ior = 1.0f;
     std::optional<std::pair<GfVec3f, GfVec3f>> bounds;
-    TfToken preset;
+    TfToken preset;              ///< measured material (core/presets.h); replaces density, albedo, extinctionColor
+    float sceneUnitsPerMm = 1.0f;
 };
 
 /// Reads the `volphoton:*` attributes of prim `id` through HdSceneDelegate::Get(), which reaches

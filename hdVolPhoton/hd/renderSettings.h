@@ -5,14 +5,17 @@
 #include "pxr/pxr.h"
 #include "pxr/imaging/hd/renderSettings.h"
 
+#include <atomic>
+
 PXR_NAMESPACE_OPEN_SCOPE
 
 class HdRenderDelegate;
 
 /// \class HdVolPhotonRenderSettings
 ///
-/// The Bprim of a UsdRenderSettings prim (scene-index imaging: usdrecord/usdview with
-/// `--renderSettingsPrimPath` or an active settings prim). When it is the active one, its
+/// The Bprim of a UsdRenderSettings prim (usdrecord's `--renderSettingsPrimPath`, usdview's
+/// active settings prim; both scene paths of OpenUSD 24.08). When it is the active one (or none is:
+/// see _Sync), its
 /// `volphoton:*` attributes (the namespaced settings Hydra filters with the delegate's
 /// GetRenderSettingsNamespaces) become the delegate's render settings, with the same names and
 /// meanings as the standalone front end reads from the same prim:
@@ -35,6 +38,7 @@ protected:
 
 private:
     HdRenderDelegate *_delegate;
+    static std::atomic<bool> _sawActive;  ///< an active settings prim was synced (in this process)
 };
 
 PXR_NAMESPACE_CLOSE_SCOPE

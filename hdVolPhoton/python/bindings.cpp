@@ -30,6 +30,7 @@
 #include "core/integrator.h"
 #include "core/lights.h"
 #include "core/phase.h"
+#include "core/presets.h"
 #include "core/scene.h"
 
 namespace py = pybind11;
@@ -366,6 +367,13 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly("world_to_index", &GridMedium::worldToIndex)
         .def_property_readonly("index_to_world", &GridMedium::indexToWorld);
     m.attr("DEFAULT_MAX_GRID_VOXELS") = GridMediumDesc::kDefaultMaxGridVoxels;
+    m.def("subsurface_presets", [] {
+        py::list out;
+        for (const SubsurfacePreset& p : subsurfacePresets())
+            out.append(py::make_tuple(p.name, py::make_tuple(p.sigmaSPrime[0], p.sigmaSPrime[1], p.sigmaSPrime[2]),
+                                      py::make_tuple(p.sigmaA[0], p.sigmaA[1], p.sigmaA[2])));
+        return out;
+    }, "[(name, sigma_s' RGB, sigma_a RGB)] in 1/mm (Jensen et al. 2001, table 2; core/presets.h)");
     m.def("load_grid_medium", [](const GridMediumDesc& desc) {
         GridMediumDesc copy = desc;
         py::gil_scoped_release release;

@@ -1,8 +1,8 @@
 """Set-up of the Hydra tests (run by tools/test.sh only where the build found OpenUSD with imaging).
 
 usdrecord is OpenUSD's own command (its Python, its pxr), run in a subprocess with:
-  * PXR_PLUGINPATH_NAME: this build's hdVolPhoton delegate and glTF file-format plug-in, installed
-    into build/hydra-stage by `cmake --install`, and the repository's schema plug-in (plugInfo/);
+  * PXR_PLUGINPATH_NAME: this build's hdVolPhoton delegate, glTF file-format plug-in and medium
+    schemas (plugInfo.json made for this OpenUSD), installed into build/hydra-stage by `cmake --install`;
   * USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX=1 where a test needs the UsdRender settings prim (the
     scene-index path is the one that hands render settings prims to delegates in OpenUSD 24.08).
 A missing usdrecord or plug-in is a failure here, not a skip: tools/test.sh prints the SKIPPED line

@@ -17,7 +17,7 @@ def make_hydra_env():
     assert p.returncode == 0, p.stdout + p.stderr
     plugin_dirs = [os.path.join(STAGE, "plugin", "usd", "hdVolPhoton", "resources"),
                    os.path.join(STAGE, "plugin", "usd", "usdVolPhotonGltf", "resources"),
-                   os.path.join(REPO, "plugInfo")]
+                   os.path.join(STAGE, "plugin", "usd", "volPhotonSchemas", "resources")]
     for d in plugin_dirs:
         assert os.path.exists(os.path.join(d, "plugInfo.json")), d
     env = dict(os.environ)

@@ -76,24 +76,17 @@ Vec3 = Tuple[float, float, float]
 
 SOURCE = ("Jensen, Marschner, Levoy, Hanrahan 2001, 'A Practical Model for Subsurface Light Transport', "
           "table 2 (as in pbrt-v4 src/pbrt/media.cpp SubsurfaceParameterTable)")
-MEASURED_IOR = 1.3
+MEASURED_IOR = 1.3  # = volphoton::MeasuredPresetIor
 
 # name -> (reduced scattering sigma_s', absorption sigma_a), RGB, 1/mm.  Keep the docstring table
 # and schemas/README.md in step (testenv/test_subsurface.py checks both).
-PRESETS: Dict[str, Tuple[Vec3, Vec3]] = {
-    "apple": ((2.29, 2.39, 1.97), (0.0030, 0.0034, 0.046)),
-    "chicken1": ((0.15, 0.21, 0.38), (0.015, 0.077, 0.19)),
-    "chicken2": ((0.19, 0.25, 0.32), (0.018, 0.088, 0.20)),
-    "cream": ((7.38, 5.47, 3.15), (0.0002, 0.0028, 0.0163)),
-    "ketchup": ((0.18, 0.07, 0.03), (0.061, 0.97, 1.45)),
-    "marble": ((2.19, 2.62, 3.00), (0.0021, 0.0041, 0.0071)),
-    "potato": ((0.68, 0.70, 0.55), (0.0024, 0.0090, 0.12)),
-    "skimmilk": ((0.70, 1.22, 1.90), (0.0014, 0.0025, 0.0142)),
-    "skin1": ((0.74, 0.88, 1.01), (0.032, 0.17, 0.48)),
-    "skin2": ((1.09, 1.59, 1.79), (0.013, 0.070, 0.145)),
-    "spectralon": ((11.6, 20.4, 14.9), (0.0, 0.0, 0.0)),
-    "wholemilk": ((2.55, 3.21, 3.77), (0.0011, 0.0024, 0.014)),
-}
+def _table() -> Dict[str, Tuple[Vec3, Vec3]]:
+    """The table lives in the C++ core (hdVolPhoton/core/presets.cpp), shared with the Hydra delegate."""
+    from . import _core
+    return {name: (tuple(ssp), tuple(sa)) for name, ssp, sa in _core.subsurface_presets()}  # type: ignore[misc]
+
+
+PRESETS: Dict[str, Tuple[Vec3, Vec3]] = _table()
 
 
 class UnknownPresetError(KeyError):
