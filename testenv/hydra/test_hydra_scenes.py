@@ -133,3 +133,14 @@ def test_broken_scene_warns_naming_prims_and_still_renders(tmp_path, hydra_env):
         image = rgb(out)
         assert np.isfinite(image).all() and image.max() > 0  # the dome and the fine sphere still render
         os.remove(out)
+
+
+def test_interactive_benchmark_runs(hydra_env):
+    """tools/bench_hydra.py (figures in the issue notes; not a timing assertion)."""
+    usdrecord_python = open(hydra_env["usdrecord"]).readline()[2:].strip()
+    p = subprocess.run([usdrecord_python, os.path.join(REPO, "tools", "bench_hydra.py"), "interactive",
+                        os.path.join(TESTENV, "furnace.usda")], capture_output=True, text=True, env=hydra_env["env"],
+                       timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    row = [l for l in p.stdout.splitlines() if l.startswith("| furnace.usda")]
+    assert row and float(row[0].split("|")[2]) > 0, p.stdout
