@@ -1,5 +1,7 @@
 #include "hd/mesh.h"
 
+#include <map>
+
 #include "pxr/base/tf/diagnostic.h"
 #include "pxr/imaging/hd/meshUtil.h"
 #include "pxr/imaging/hd/renderIndex.h"
@@ -44,11 +46,27 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
     VtVec3iArray triangles;
     VtIntArray primitiveParams;
     meshUtil.ComputeTriangleIndices(&triangles, &primitiveParams);
+    // Faces bound to a material by a GeomSubset: their triangles become a part of their own.
+    std::map<int, size_t> faceSubset;
+    for (HdGeomSubset const &subset : topology.GetGeomSubsets()) {
+        if (subset.type != HdGeomSubset::TypeFaceSet || subset.materialId.IsEmpty()) continue;
+        rec.subsets.push_back({subset.materialId, {}});
+        for (int face : subset.indices) faceSubset[face] = rec.subsets.size() - 1;
+    }
     size_t dropped = 0;
-    for (GfVec3i const &t : triangles) {
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        GfVec3i const &t = triangles[i];
         bool valid = true;
         for (int k = 0; k < 3; ++k) valid &= t[k] >= 0 && static_cast<size_t>(t[k]) < points.size();
         if (!valid) { ++dropped; continue; }
+        if (!faceSubset.empty()) {
+            auto it = faceSubset.find(HdMeshUtil::DecodeFaceIndexFromCoarseFaceParam(primitiveParams[i]));
+            if (it != faceSubset.end()) {
+                rec.subsets[it->second].second.insert(rec.subsets[it->second].second.end(),
+                                                      {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+                continue;
+            }
+        }
         rec.mesh.indices.insert(rec.mesh.indices.end(), {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
     }
     if (dropped) TF_WARN("%s: %zu triangles index points out of range; dropped", id.GetText(), dropped);
@@ -67,6 +85,7 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
     // XXX: UsdPreviewSurface networks (diffuseColor, emissiveColor) are read by the usd-core front
     //      end only; the delegate uses displayColor.
 
+    rec.materialId = sceneDelegate->GetMaterialId(id);
     if (auto medium = HdVolPhoton_ReadMediumParams(sceneDelegate, id)) {
         rec.hasMedium = true;
         rec.medium = *medium;

@@ -9,6 +9,7 @@
 #include "hd/field.h"
 #include "hd/instancer.h"
 #include "hd/light.h"
+#include "hd/material.h"
 #include "hd/mesh.h"
 #include "hd/renderBuffer.h"
 #include "hd/renderParam.h"
@@ -32,7 +33,8 @@ TfTokenVector const &_Rprims() {
 }
 TfTokenVector const &_Sprims() {
     static TfTokenVector v = {HdPrimTypeTokens->camera,     HdPrimTypeTokens->distantLight, HdPrimTypeTokens->sphereLight,
-                              HdPrimTypeTokens->rectLight, HdPrimTypeTokens->diskLight,    HdPrimTypeTokens->domeLight};
+                              HdPrimTypeTokens->rectLight, HdPrimTypeTokens->diskLight,    HdPrimTypeTokens->domeLight,
+                              HdPrimTypeTokens->material};
     return v;
 }
 TfTokenVector const &_Bprims() {
@@ -153,12 +155,14 @@ void HdVolPhotonRenderDelegate::DestroyRprim(HdRprim *rPrim) { delete rPrim; }
 HdSprim *HdVolPhotonRenderDelegate::CreateSprim(TfToken const &typeId, SdfPath const &sprimId) {
     if (typeId == HdPrimTypeTokens->camera) return new HdCamera(sprimId);
     if (_IsLight(typeId)) return new HdVolPhotonLight(sprimId, typeId);
+    if (typeId == HdPrimTypeTokens->material) return new HdVolPhotonMaterial(sprimId);
     TF_CODING_ERROR("hdVolPhoton: unknown sprim type %s", typeId.GetText());
     return nullptr;
 }
 HdSprim *HdVolPhotonRenderDelegate::CreateFallbackSprim(TfToken const &typeId) {
     if (typeId == HdPrimTypeTokens->camera) return new HdCamera(SdfPath::EmptyPath());
     if (_IsLight(typeId)) return new HdVolPhotonLight(SdfPath::EmptyPath(), typeId);
+    if (typeId == HdPrimTypeTokens->material) return new HdVolPhotonMaterial(SdfPath::EmptyPath());
     return nullptr;
 }
 void HdVolPhotonRenderDelegate::DestroySprim(HdSprim *sPrim) { delete sPrim; }

@@ -28,8 +28,13 @@ void HdVolPhoton_SceneRegistry::SetLight(SdfPath const &id, LightPtr light) {
     if (light) _lights[id] = std::move(light);
     else _lights.erase(id);
 }
+void HdVolPhoton_SceneRegistry::SetMaterial(SdfPath const &id, HdVolPhoton_MaterialRecord record) {
+    std::lock_guard<std::mutex> lock(_mutex);
+    _materials[id] = std::move(record);
+}
 void HdVolPhoton_SceneRegistry::Remove(SdfPath const &id) {
     std::lock_guard<std::mutex> lock(_mutex);
+    _materials.erase(id);
     _meshes.erase(id);
     _volumes.erase(id);
     _fields.erase(id);
@@ -80,22 +85,43 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
     SceneDesc d;
     d.camera = camera;
     for (auto const &[id, rec] : _meshes) {
-        if (rec.instances.empty() || rec.mesh.indices.empty()) continue;
-        MeshDesc mesh = rec.mesh;
-        if (rec.hasMedium) {
-            try {
-                // The medium lives in the space of the first instance (media are not instanced).
-                d.media.push_back(_ProceduralMedium(rec.medium, rec.instances[0], infiniteBounds(), id));
-                mesh.interiorMedium = static_cast<int>(d.media.size()) - 1;
-                mesh.material.kind = rec.medium.ior > 1.0f ? SurfaceMaterial::Kind::Dielectric : SurfaceMaterial::Kind::Boundary;
-                mesh.material.ior = rec.medium.ior;
-            } catch (std::exception const &e) {
-                TF_WARN("%s: medium ignored: %s", id.GetText(), e.what());
+        if (rec.instances.empty()) continue;
+        // The mesh's own faces, then one part per material-bound GeomSubset (media ignore subsets).
+        std::vector<std::pair<SdfPath, MeshDesc>> parts{{rec.materialId, rec.mesh}};
+        for (auto const &[materialId, indices] : rec.subsets) {
+            if (rec.hasMedium) {
+                parts[0].second.indices.insert(parts[0].second.indices.end(), indices.begin(), indices.end());
+                continue;
             }
+            MeshDesc part = rec.mesh;
+            part.name = id.GetString() + ":" + materialId.GetName();
+            part.indices = indices;
+            parts.push_back({materialId, std::move(part)});
         }
-        d.meshes.push_back(std::move(mesh));
-        int index = static_cast<int>(d.meshes.size()) - 1;
-        for (Affine const &xf : rec.instances) d.instances.push_back({index, xf});
+        for (auto &[materialId, mesh] : parts) {
+            if (mesh.indices.empty()) continue;
+            if (!rec.hasMedium && !materialId.IsEmpty()) {
+                auto m = _materials.find(materialId);
+                if (m != _materials.end() && m->second.valid) {
+                    if (!m->second.material) continue;  // cut out or fully transparent: not rendered
+                    mesh.material = *m->second.material;
+                }
+            }
+            if (rec.hasMedium) {
+                try {
+                    // The medium lives in the space of the first instance (media are not instanced).
+                    d.media.push_back(_ProceduralMedium(rec.medium, rec.instances[0], infiniteBounds(), id));
+                    mesh.interiorMedium = static_cast<int>(d.media.size()) - 1;
+                    mesh.material.kind = rec.medium.ior > 1.0f ? SurfaceMaterial::Kind::Dielectric : SurfaceMaterial::Kind::Boundary;
+                    mesh.material.ior = rec.medium.ior;
+                } catch (std::exception const &e) {
+                    TF_WARN("%s: medium ignored: %s", id.GetText(), e.what());
+                }
+            }
+            d.meshes.push_back(std::move(mesh));
+            int index = static_cast<int>(d.meshes.size()) - 1;
+            for (Affine const &xf : rec.instances) d.instances.push_back({index, xf});
+        }
     }
     for (auto const &[id, rec] : _volumes) {
         HdVolPhoton_MediumParams const &p = rec.medium;

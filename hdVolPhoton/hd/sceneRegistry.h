@@ -10,6 +10,7 @@
 #include "hd/mediumParams.h"
 
 #include <map>
+#include <optional>
 #include <mutex>
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -21,6 +22,15 @@ struct HdVolPhoton_MeshRecord {
     std::vector<volphoton::Affine> instances;  ///< world transforms (one when not instanced)
     bool hasMedium = false;
     HdVolPhoton_MediumParams medium;
+    SdfPath materialId;  ///< bound material of the faces in no subset
+    /// GeomSubsets with a material binding: (material, their triangles' vertex indices, 3 per triangle).
+    std::vector<std::pair<SdfPath, std::vector<uint32_t>>> subsets;
+};
+
+/// A material as synced: valid when it had a UsdPreviewSurface; material empty = not rendered.
+struct HdVolPhoton_MaterialRecord {
+    bool valid = false;
+    std::optional<volphoton::SurfaceMaterial> material;
 };
 
 /// An OpenVDB field prim (openvdbAsset): where its grid is.
@@ -50,6 +60,7 @@ public:
     void SetVolume(SdfPath const &id, HdVolPhoton_VolumeRecord record);
     void SetField(SdfPath const &id, HdVolPhoton_FieldRecord record);
     void SetLight(SdfPath const &id, volphoton::LightPtr light);
+    void SetMaterial(SdfPath const &id, HdVolPhoton_MaterialRecord record);
     void Remove(SdfPath const &id);
 
     /// Translates everything into the core's description: loads VDB grids (cached by file, grid
@@ -68,6 +79,7 @@ private:
     std::map<SdfPath, HdVolPhoton_VolumeRecord> _volumes;
     std::map<SdfPath, HdVolPhoton_FieldRecord> _fields;
     std::map<SdfPath, volphoton::LightPtr> _lights;
+    std::map<SdfPath, HdVolPhoton_MaterialRecord> _materials;
     mutable std::map<std::string, volphoton::MediumPtr> _gridCache;
 };
 

@@ -31,6 +31,7 @@
 #include "core/lights.h"
 #include "core/phase.h"
 #include "core/presets.h"
+#include "core/previewSurface.h"
 #include "core/scene.h"
 
 namespace py = pybind11;
@@ -367,6 +368,24 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly("world_to_index", &GridMedium::worldToIndex)
         .def_property_readonly("index_to_world", &GridMedium::indexToWorld);
     m.attr("DEFAULT_MAX_GRID_VOXELS") = GridMediumDesc::kDefaultMaxGridVoxels;
+    m.def("preview_surface_material", [](std::tuple<double, double, double> diffuse, std::tuple<double, double, double> emissive,
+                                         double opacity, double opacityThreshold, double ior, bool iorAuthored, double metallic) {
+        PreviewSurfaceInputs in;
+        in.diffuseColor = Spectrum(std::get<0>(diffuse), std::get<1>(diffuse), std::get<2>(diffuse));
+        in.emissiveColor = Spectrum(std::get<0>(emissive), std::get<1>(emissive), std::get<2>(emissive));
+        in.opacity = opacity;
+        in.opacityThreshold = opacityThreshold;
+        in.ior = ior;
+        in.iorAuthored = iorAuthored;
+        in.metallic = metallic;
+        std::vector<PreviewSurfaceNote> notes;
+        std::optional<SurfaceMaterial> m = previewSurfaceMaterial(in, &notes);
+        py::list out;
+        for (const PreviewSurfaceNote& n : notes) out.append(py::make_tuple(n.error ? "error" : "warning", n.input, n.message));
+        return py::make_tuple(m ? py::cast(*m) : py::none(), out);
+    }, py::arg("diffuse"), py::arg("emissive"), py::arg("opacity"), py::arg("opacity_threshold"), py::arg("ior"),
+       py::arg("ior_authored"), py::arg("metallic"),
+       "(SurfaceMaterial or None = not rendered, [(severity, input, message)]): core/previewSurface.h's rules");
     m.def("subsurface_presets", [] {
         py::list out;
         for (const SubsurfacePreset& p : subsurfacePresets())

@@ -26,16 +26,7 @@ from volphoton import output  # noqa: E402
 SEEDS = [1, 2, 3, 4]
 SIZE = (64, 36)
 SPP = 4
-# Scenes whose match fails for a known gap of the delegate. strict: the assertion still runs, and the
-# test fails the day the gap is closed (so this list cannot go stale).
-KNOWN_GAPS = {
-    "subsurface_milk.usda": "XXX: the delegate reads displayColor only, not UsdPreviewSurface: the clear glass "
-                            "(opacity 0, ior 1.5) renders as an opaque grey surface",
-    "gltf_statue.usda": "XXX: the delegate reads displayColor only (its first value), not UsdPreviewSurface "
-                        "materials bound per GeomSubset: the pedestal's two glTF materials become one colour",
-}
-SCENES = [pytest.param(f, marks=pytest.mark.xfail(strict=True, reason=KNOWN_GAPS[f])) if f in KNOWN_GAPS else f
-          for f in sorted(f for f in os.listdir(TESTENV) if f.endswith(".usda"))]
+SCENES = sorted(f for f in os.listdir(TESTENV) if f.endswith(".usda"))
 
 
 def image_size(scene):

@@ -583,33 +583,13 @@ def _preview_material(material: UsdShade.Material, time, d: _Diags):
     threshold, _ = _shader_input(shader, "opacityThreshold", time, d)
     ior, ior_authored = _shader_input(shader, "ior", time, d)
     metallic, _ = _shader_input(shader, "metallic", time, d)
-    diffuse, emissive = _tuple3(diffuse), _tuple3(emissive)
-    opacity, threshold, ior, metallic = float(opacity), float(threshold), float(ior), float(metallic)
-    for name, v in (("diffuseColor", diffuse), ("emissiveColor", emissive)):
-        if not _finite(v):
-            d.error(spath, "inputs:" + name, "%s is not finite; using the default" % name)
-    if not _finite(diffuse):
-        diffuse = _PREVIEW_DEFAULTS["diffuseColor"]
-    if not _finite(emissive):
-        emissive = (0.0, 0.0, 0.0)
-    clamped = tuple(min(max(c, 0.0), 1.0) for c in diffuse)
-    if clamped != diffuse:
-        d.warn(spath, "inputs:diffuseColor", "diffuseColor %s outside [0, 1]; clamped to %s" % (diffuse, clamped))
-    if min(emissive) < 0:
-        d.warn(spath, "inputs:emissiveColor", "negative emissiveColor clamped to 0")
-        emissive = tuple(max(c, 0.0) for c in emissive)
-    if metallic > 0:
-        d.warn(spath, "inputs:metallic", "metallic = %g is not supported; rendered as diffuse" % metallic)
-    if threshold > 0 and opacity < threshold:
-        return None  # cutout
-    if opacity <= 1e-3:
-        if ior_authored and ior > 1.0 + 1e-6:
-            return _core.SurfaceMaterial(kind=_core.SurfaceMaterial.Kind.Dielectric, ior=ior)
-        return None  # fully transparent
-    if opacity < 1.0:
-        d.warn(spath, "inputs:opacity", "opacity = %g: partial transparency is not supported; rendered opaque "
-               "(use opacity 0 with an ior for glass)" % opacity)
-    return _core.SurfaceMaterial(albedo=clamped, emission=emissive)
+    # The rules are the core's (core/previewSurface.h), shared with the Hydra delegate.
+    material, notes = _core.preview_surface_material(_tuple3(diffuse), _tuple3(emissive), float(opacity),
+                                                     float(threshold), float(ior), bool(ior_authored),
+                                                     float(metallic))
+    for severity, name, message in notes:
+        (d.error if severity == "error" else d.warn)(spath, "inputs:" + name, message)
+    return material
 
 
 def _display_color(prim: Usd.Prim, time):
