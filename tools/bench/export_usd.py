@@ -69,6 +69,16 @@ def _color_intensity(rgb):
     return float(m), tuple(float(c / m) for c in rgb)
 
 
+def _define_mesh(UsdGeom, Gf, stage, path: str, points, tris):
+    """A triangle Mesh prim (no subdivision) with the given object-space points and triangles."""
+    mesh = UsdGeom.Mesh.Define(stage, path)
+    mesh.CreatePointsAttr([Gf.Vec3f(*map(float, p)) for p in points])
+    mesh.CreateFaceVertexCountsAttr([3] * len(tris))
+    mesh.CreateFaceVertexIndicesAttr([int(i) for i in np.asarray(tris).reshape(-1)])
+    mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    return mesh
+
+
 def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) -> str:
     Gf, Sdf, Usd, UsdGeom, UsdLux, UsdRender, UsdVol = _ensure_pxr()
     layer = Sdf.Layer.CreateAnonymous(".usda")
@@ -106,21 +116,13 @@ def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) ->
     _xform(UsdGeom, Gf, cam.GetPrim(), scene.camera.to_world())
 
     for s in scene.surfaces:
-        mesh = UsdGeom.Mesh.Define(stage, "/World/" + s.name)
-        mesh.CreatePointsAttr([Gf.Vec3f(*map(float, p)) for p in s.points])
-        mesh.CreateFaceVertexCountsAttr([3] * len(s.tris))
-        mesh.CreateFaceVertexIndicesAttr([int(i) for i in np.asarray(s.tris).reshape(-1)])
-        mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+        mesh = _define_mesh(UsdGeom, Gf, stage, "/World/" + s.name, s.points, s.tris)
         mesh.CreateDisplayColorAttr([Gf.Vec3f(*s.albedo)])
         _xform(UsdGeom, Gf, mesh.GetPrim(), s.to_world)
 
     for m in scene.media:
         if isinstance(m, S.BoxMedium):
-            mesh = UsdGeom.Mesh.Define(stage, "/World/" + m.name)
-            mesh.CreatePointsAttr([Gf.Vec3f(*map(float, p)) for p in S.BOX_POINTS])
-            mesh.CreateFaceVertexCountsAttr([3] * len(S.BOX_TRIS))
-            mesh.CreateFaceVertexIndicesAttr([int(i) for i in S.BOX_TRIS.reshape(-1)])
-            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            mesh = _define_mesh(UsdGeom, Gf, stage, "/World/" + m.name, S.BOX_POINTS, S.BOX_TRIS)
             prim = mesh.GetPrim()
             _apply_medium_api(prim, Sdf)
             _set(prim, Sdf, "volphoton:ior", Sdf.ValueTypeNames.Float, 1.0)
@@ -164,11 +166,7 @@ def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) ->
             _set(prim, Sdf, "volphoton:bounds:min", Sdf.ValueTypeNames.Point3f, Gf.Vec3f(*m.lo))
             _set(prim, Sdf, "volphoton:bounds:max", Sdf.ValueTypeNames.Point3f, Gf.Vec3f(*m.hi))
         elif isinstance(m, S.TranslucentMesh):
-            mesh = UsdGeom.Mesh.Define(stage, "/World/" + m.name)
-            mesh.CreatePointsAttr([Gf.Vec3f(*map(float, p)) for p in m.points])
-            mesh.CreateFaceVertexCountsAttr([3] * len(m.tris))
-            mesh.CreateFaceVertexIndicesAttr([int(i) for i in np.asarray(m.tris).reshape(-1)])
-            mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+            mesh = _define_mesh(UsdGeom, Gf, stage, "/World/" + m.name, m.points, m.tris)
             prim = mesh.GetPrim()
             _apply_medium_api(prim, Sdf)
             _set(prim, Sdf, "volphoton:ior", Sdf.ValueTypeNames.Float, float(m.ior))
