@@ -37,9 +37,11 @@ DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng) const {
     return d;
 }
 
-bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light) const {
+bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
+                          bool cameraRay) const {
     bool found = false;
     for (size_t i = 0; i < scene_.lights().size(); ++i) {
+        if (cameraRay && !settings_.domeVisibleToCamera && scene_.lights()[i]->isDome()) continue;
         double th;
         Spectrum L;
         double p;

@@ -24,6 +24,10 @@
 // | photonMapBudgetBytes| size_t | 1 GiB      | bytes        | photonMap: memory cap of one pass's photon map;   |
 // |                     |        |            |              | beyond it photons are thinned at random, their    |
 // |                     |        |            |              | power scaled up (unbiased), and the stats say so  |
+// | domeVisibleToCamera | bool   | true       |              | false: camera rays that escape (straight through  |
+// |                     |        |            |              | media and index-matched boundaries) see black and |
+// |                     |        |            |              | alpha 0; the dome still lights the scene (Hydra's |
+// |                     |        |            |              | domeLightCameraVisibility)                        |
 //
 // AOVs: the light-path split is decided by the first vertex of the camera path other than an
 // index-matched medium boundary:
@@ -66,6 +70,7 @@ struct RenderSettings {
     double multipleThreshold = 1e-3;
     double transmittanceCutoff = 0;
     size_t photonMapBudgetBytes = size_t(1) << 30;
+    bool domeVisibleToCamera = true;
 };
 
 /// What ran, what was skipped and why, and how long each part took.

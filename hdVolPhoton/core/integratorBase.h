@@ -76,7 +76,9 @@ protected:
     /// Probability that sampleDirect() picks light i times the light's own solid-angle density.
     double lightPickProb(int light) const { return lightDist_.size() ? lightDist_.discretePdf(light) : 0.0; }
     /// Nearest light with extent hit by ray before tMax (including escape to dome/distant lights).
-    bool hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light) const;
+    /// The nearest light the ray meets before tMax. cameraRay: the ray is still the camera's own (first
+    /// segment), so a dome hidden by RenderSettings::domeVisibleToCamera is not met.
+    bool hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light, bool cameraRay) const;
     /// Transmittance from p along unit w over dist, through media and index-matched boundaries;
     /// 0 if any other surface blocks. `stack` is the medium stack at p; surfaces are searched from
     /// t = tMin (a spawn offset off the surface p lies on), media from t = 0.

@@ -311,6 +311,7 @@ public:
         return true;
     }
     bool isDelta() const override { return false; }
+    bool isDome() const override { return true; }
     Spectrum power(double r) const override { return L_ * integral_ * (Pi * r * r); }
     PhotonEmission emitPhoton(const Vec3& c, double r, double u[4]) const override {
         double pdf;

@@ -47,6 +47,8 @@ public:
     /// solid-angle density sample() would have produced the direction with.
     virtual bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const = 0;
     virtual bool isDelta() const = 0;
+    /// The environment (dome) light: RenderSettings::domeVisibleToCamera may hide it from camera rays.
+    virtual bool isDome() const { return false; }
     /// Position of a point (or point spot) light, for equiangular sampling; nullopt for others.
     virtual std::optional<Vec3> pointPosition() const { return std::nullopt; }
     /// Centre towards which equiangular sampling aims (point, spot and sphere lights); nullopt for others.

@@ -100,7 +100,7 @@ public:
             Spectrum lightLe;
             double lightPdf;
             int light = -1;
-            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light);
+            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light, firstSegment);
             if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
             if (firstSegment && hasHit) out.depth = hit.t;
             double leakExit = hasHit ? Infinity : leakDistance(stack, ray);

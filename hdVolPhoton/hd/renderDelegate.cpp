@@ -97,6 +97,8 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     s.initialRadius = std::max(0.0f, GetRenderSetting<float>(HdVolPhotonRenderSettingsTokens->initialRadius, 0.0f));
     s.singleScattering = GetRenderSetting<bool>(HdVolPhotonRenderSettingsTokens->singleScattering, true);
     s.multipleScattering = GetRenderSetting<bool>(HdVolPhotonRenderSettingsTokens->multipleScattering, true);
+    // usdrecord hides domes from the camera unless --enableDomeLightVisibility; usdview shows them.
+    s.domeVisibleToCamera = GetRenderSetting<bool>(HdRenderSettingsTokens->domeLightCameraVisibility, true);
     s.seed = static_cast<uint64_t>(std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->seed, 0)));
     return s;
 }

@@ -140,6 +140,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["multipleThreshold"] = s.multipleThreshold;
     d["transmittanceCutoff"] = s.transmittanceCutoff;
     d["photonMapBudgetBytes"] = s.photonMapBudgetBytes;
+    d["domeVisibleToCamera"] = s.domeVisibleToCamera;
     return d;
 }
 
@@ -647,6 +648,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("multiple_threshold", &RenderSettings::multipleThreshold)
         .def_readwrite("transmittance_cutoff", &RenderSettings::transmittanceCutoff)
         .def_readwrite("photon_map_budget_bytes", &RenderSettings::photonMapBudgetBytes)
+        .def_readwrite("dome_visible_to_camera", &RenderSettings::domeVisibleToCamera)
         .def("to_dict", &settingsToDict, "Settings under their documented (integrator.h) names")
         .def("__repr__", [](const RenderSettings& s) { return py::repr(settingsToDict(s)).cast<std::string>(); });
 

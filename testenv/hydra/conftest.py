@@ -3,8 +3,8 @@
 usdrecord is OpenUSD's own command (its Python, its pxr), run in a subprocess with:
   * PXR_PLUGINPATH_NAME: this build's hdVolPhoton delegate, glTF file-format plug-in and medium
     schemas (plugInfo.json made for this OpenUSD), installed into build/hydra-stage by `cmake --install`;
-  * USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX=1 where a test needs the UsdRender settings prim (the
-    scene-index path is the one that hands render settings prims to delegates in OpenUSD 24.08).
+  * usdrecord's default scene path (the legacy scene delegate in OpenUSD 24.08);
+    USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX=1 only where a test asks for the scene-index path.
 A missing usdrecord or plug-in is a failure here, not a skip: tools/test.sh prints the SKIPPED line
 when there is no OpenUSD build at all.
 """

@@ -28,7 +28,7 @@ def make_hydra_env():
     return {"usdrecord": usdrecord, "env": env}
 
 
-def run_usdrecord(hydra_env, args, scene_index=True, timeout=600):
+def run_usdrecord(hydra_env, args, scene_index=False, timeout=600):
     env = dict(hydra_env["env"])
     if scene_index:
         env["USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX"] = "1"

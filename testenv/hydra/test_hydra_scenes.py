@@ -144,3 +144,18 @@ def test_interactive_benchmark_runs(hydra_env):
     assert p.returncode == 0, p.stderr[-2000:]
     row = [l for l in p.stdout.splitlines() if l.startswith("| furnace.usda")]
     assert row and float(row[0].split("|")[2]) > 0, p.stdout
+
+
+def test_dome_hidden_from_the_camera_unless_asked(tmp_path, hydra_env):
+    """usdrecord sets domeLightCameraVisibility off unless --enableDomeLightVisibility: the furnace's
+    dome (radiance 1) is then black where the camera sees it directly, and still lights the scene."""
+    means = {}
+    for visible in (True, False):
+        out = str(tmp_path / ("furnace_%d.exr" % visible))
+        args = ["--camera", "/World/camera", "--imageWidth", "32"] + (["--enableDomeLightVisibility"] if visible else [])
+        r = run_usdrecord(hydra_env, args + [os.path.join(TESTENV, "furnace.usda"), out])
+        assert r.returncode == 0, r.stdout + r.stderr
+        image = rgb(out)
+        means[visible] = (float(image[0, 0].mean()), float(image.mean()))
+    assert means[True][0] == 1.0 and means[False][0] == 0.0, means  # a corner pixel: the dome directly
+    assert 0 < means[False][1] < means[True][1], means               # the lit medium remains

@@ -594,3 +594,39 @@ TEST(IntegratorCancel, CancelStopsTilesAndPhotonBatches) {
             }
     }
 }
+
+TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
+    // domeVisibleToCamera = false (Hydra's domeLightCameraVisibility): camera rays that escape see
+    // black; everything the dome lights is unchanged. With the same seed the two renders take the same
+    // random decisions, so no pixel gets brighter, pixels no sample of which met the medium are 0,
+    // and the lit cube is still there.
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}),
+                                   Vec3(0.2, 0.1, 3));
+        auto scene = std::make_shared<Scene>(d);
+        RenderSettings s = smallSettings(integrator, 4, 7);
+        s.width = s.height = 16;
+        Renderer visible(scene, s);
+        visible.render();
+        s.domeVisibleToCamera = false;
+        Renderer hidden(scene, s);
+        hidden.render();
+        auto v = visible.film().resolveRgb(Film::Beauty), h = hidden.film().resolveRgb(Film::Beauty);
+        auto alpha = visible.film().resolveAlpha();
+        int background = 0;
+        double lit = 0;
+        for (size_t p = 0; p < alpha.size(); ++p) {
+            for (int ch = 0; ch < 3; ++ch) EXPECT_LE(h[3 * p + ch], v[3 * p + ch] + 1e-9) << "pixel " << p;
+            if (alpha[p] == 0) {
+                ++background;
+                EXPECT_NEAR(v[3 * p], 1.0, 1e-9) << "pixel " << p;  // the dome seen directly
+                EXPECT_EQ(h[3 * p], 0.0) << "pixel " << p;
+            } else {
+                lit += h[3 * p];
+            }
+        }
+        EXPECT_GT(background, 0);
+        EXPECT_GT(lit, 0.0);
+    }
+}
