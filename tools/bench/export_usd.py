@@ -62,6 +62,13 @@ def _phase(prim, Sdf, phase: S.Phase) -> None:
         _set(prim, Sdf, "volphoton:phase:g", Sdf.ValueTypeNames.Float, float(phase.g))
 
 
+def _set_emission(Gf, light, rgb) -> None:
+    """A UsdLux light's intensity x color = rgb (its peak channel as intensity)."""
+    inten, col = _color_intensity(rgb)
+    light.CreateIntensityAttr(inten)
+    light.CreateColorAttr(Gf.Vec3f(*col))
+
+
 def _color_intensity(rgb):
     m = max(rgb)
     if m <= 0:
@@ -184,30 +191,22 @@ def write_usda(scene: S.BenchScene, path: str, resolution=DEFAULT_RESOLUTION) ->
     for i, l in enumerate(scene.lights):
         if isinstance(l, S.Dome):
             light = UsdLux.DomeLight.Define(stage, "/World/dome%d" % i)
-            inten, col = _color_intensity(l.radiance)
-            light.CreateIntensityAttr(inten)
-            light.CreateColorAttr(Gf.Vec3f(*col))
+            _set_emission(Gf, light, l.radiance)
         elif isinstance(l, S.SphereLight):
             light = UsdLux.SphereLight.Define(stage, "/World/sphere%d" % i)
-            inten, col = _color_intensity(l.radiance)  # normalize off: intensity x color = radiance
-            light.CreateIntensityAttr(inten)
-            light.CreateColorAttr(Gf.Vec3f(*col))
+            _set_emission(Gf, light, l.radiance)  # normalize off: intensity x color = radiance
             light.CreateRadiusAttr(float(l.radius))
             light.CreateTreatAsPointAttr(False)
             _xform(UsdGeom, Gf, light.GetPrim(), S.translate(l.position))
         elif isinstance(l, S.Distant):
             light = UsdLux.DistantLight.Define(stage, "/World/sun%d" % i)
-            inten, col = _color_intensity(l.irradiance)
-            light.CreateIntensityAttr(inten)
-            light.CreateColorAttr(Gf.Vec3f(*col))
+            _set_emission(Gf, light, l.irradiance)
             light.CreateAngleAttr(0.0)
             light.CreateNormalizeAttr(True)
             _xform(UsdGeom, Gf, light.GetPrim(), S.frame_z_to(l.direction))
         elif isinstance(l, S.Spot):
             light = UsdLux.SphereLight.Define(stage, "/World/spot%d" % i)
-            inten, col = _color_intensity(l.intensity)
-            light.CreateIntensityAttr(inten)
-            light.CreateColorAttr(Gf.Vec3f(*col))
+            _set_emission(Gf, light, l.intensity)
             light.CreateRadiusAttr(0.0)
             light.CreateTreatAsPointAttr(True)
             shaping = UsdLux.ShapingAPI.Apply(light.GetPrim())
