@@ -15,21 +15,6 @@
 
 namespace volphoton::gltf {
 
-bool Translation::hasErrors() const {
-    return std::any_of(diagnostics.begin(), diagnostics.end(),
-                       [](const Diagnostic& d) { return d.severity == Severity::Error; });
-}
-
-std::string Translation::format(const std::string& file) const {
-    std::string out;
-    for (const Diagnostic& d : diagnostics) {
-        out += file + ": " + (d.severity == Severity::Error ? "error: " : "warning: ");
-        if (!d.element.empty()) out += d.element + ": ";
-        out += d.message + "\n";
-    }
-    return out;
-}
-
 std::string makeIdentifier(const std::string& name, const std::string& fallback) {
     std::string id;
     for (char c : name) {

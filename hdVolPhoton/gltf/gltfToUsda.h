@@ -56,10 +56,6 @@ struct Translation {
     std::size_t triangles = 0;
     std::size_t meshPrims = 0;
     std::size_t nodePrims = 0;
-
-    bool hasErrors() const;
-    /// "file: element: message" lines, one per diagnostic.
-    std::string format(const std::string& file) const;
 };
 
 struct Options {
