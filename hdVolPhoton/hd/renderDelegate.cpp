@@ -172,14 +172,14 @@ void HdVolPhotonRenderDelegate::DestroySprim(HdSprim *sPrim) { delete sPrim; }
 HdBprim *HdVolPhotonRenderDelegate::CreateBprim(TfToken const &typeId, SdfPath const &bprimId) {
     if (typeId == HdPrimTypeTokens->renderBuffer) return new HdVolPhotonRenderBuffer(bprimId);
     if (typeId == _OpenvdbAsset()) return new HdVolPhotonField(bprimId);
-    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(bprimId, this);
+    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(bprimId, this, &_sawActiveSettings);
     TF_CODING_ERROR("hdVolPhoton: unknown bprim type %s", typeId.GetText());
     return nullptr;
 }
 HdBprim *HdVolPhotonRenderDelegate::CreateFallbackBprim(TfToken const &typeId) {
     if (typeId == HdPrimTypeTokens->renderBuffer) return new HdVolPhotonRenderBuffer(SdfPath::EmptyPath());
     if (typeId == _OpenvdbAsset()) return new HdVolPhotonField(SdfPath::EmptyPath());
-    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(SdfPath::EmptyPath(), this);
+    if (typeId == HdPrimTypeTokens->renderSettings) return new HdVolPhotonRenderSettings(SdfPath::EmptyPath(), this, &_sawActiveSettings);
     return nullptr;
 }
 void HdVolPhotonRenderDelegate::DestroyBprim(HdBprim *bPrim) { delete bPrim; }

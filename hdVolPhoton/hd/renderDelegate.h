@@ -92,6 +92,7 @@ private:
     void _Initialize();
 
     std::atomic<int> _sceneVersion{0};
+    std::atomic<bool> _sawActiveSettings{false};  ///< see HdVolPhotonRenderSettings::_Sync
     HdRenderThread _renderThread;
     HdVolPhoton_Renderer _renderer;
     std::unique_ptr<HdVolPhotonRenderParam> _renderParam;

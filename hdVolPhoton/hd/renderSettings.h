@@ -31,14 +31,15 @@ class HdRenderDelegate;
 class HdVolPhotonRenderSettings final : public HdRenderSettings
 {
 public:
-    HdVolPhotonRenderSettings(SdfPath const &id, HdRenderDelegate *delegate);
+    /// sawActive: the delegate's flag, shared by its settings prims (see _Sync).
+    HdVolPhotonRenderSettings(SdfPath const &id, HdRenderDelegate *delegate, std::atomic<bool> *sawActive);
 
 protected:
     void _Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *renderParam, HdDirtyBits const *dirtyBits) override;
 
 private:
     HdRenderDelegate *_delegate;
-    static std::atomic<bool> _sawActive;  ///< an active settings prim was synced (in this process)
+    std::atomic<bool> *_sawActive;  ///< an active settings prim of this delegate was synced
 };
 
 PXR_NAMESPACE_CLOSE_SCOPE
