@@ -994,13 +994,6 @@ KNOWN_ISSUES = [
     (lambda c, w, m: w == "malformed vdb_value_huge" and "hang" in m,
      "the same grid cost: a VDB of density 3e38 (x5) makes every ray through the grid's empty corners take "
      "~1e39 null collisions per unit length; the render never ends (1e6 already takes 6 s for 96 paths)"),
-    (lambda c, w, m: c.get("kind") == "exponential" and max(c.get("a", 0), c.get("b", 0)) >= 1e6 and "photonMap" in w
-     and "furnace" in m,
-     "photonMap energy gain in extreme exponential media (a or b = 1e6): the mean free path at the medium's "
-     "surface (1e-6) is far below the beam radius (auto: 1/100 of the scene), so photons stored just inside "
-     "the opaque layer are gathered by camera segments passing within the radius outside it, with the "
-     "camera transmittance of the segment (~1), not of the photon; white furnace 1.5-45 L. The path tracer "
-     "stays <= 1 L. (A clamped-density majorant bug that also gained energy here is fixed.)"),
 ]
 
 

@@ -167,6 +167,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     if (settings_.maxDepth < 0) throw std::invalid_argument("render settings: maxDepth must be >= 0");
     if (settings_.photonsPerPass < 0) throw std::invalid_argument("render settings: photonsPerPass must be >= 0");
     if (!(settings_.radiusAlpha > 0 && settings_.radiusAlpha <= 1)) throw std::invalid_argument("render settings: radiusAlpha must be in (0, 1]");
+    if (!(settings_.photonRadiusMfp >= 0)) throw std::invalid_argument("render settings: photonRadiusMfp must be >= 0");
     integrator_ = settings_.integrator == RenderSettings::Integrator::PhotonMap ? makePhotonMapper(*scene_, settings_)
                                                                                : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");

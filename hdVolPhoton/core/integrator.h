@@ -14,6 +14,9 @@
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the scene diameter)                               |
 // | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
+// | photonRadiusMfp     | double | 1          | mean free    | photonMap: a photon's radius is at most this many |
+// |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon;    |
+// |                     |        |            |              | 0: no cap (the pass radius for every photon)      |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
 // |                     |        |            |              | the scene diameter)                               |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |
@@ -64,6 +67,7 @@ struct RenderSettings {
     int photonsPerPass = 100000;
     double initialRadius = 0;
     double radiusAlpha = 0.7;
+    double photonRadiusMfp = 1;
     double marchStep = 0;
     bool singleScattering = true;
     bool multipleScattering = true;
@@ -84,6 +88,7 @@ struct RenderStats {
     double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
     size_t photonMapBytes = 0;
     uint64_t photonsThinned = 0;  ///< photons dropped to stay within photonMapBudgetBytes
+    uint64_t photonsRadiusCapped = 0;  ///< stored photons whose kernel the photonRadiusMfp cap narrowed
     std::vector<std::string> passesRun;
     std::vector<std::string> passesSkipped;  ///< "name: reason"
     bool cancelled = false;

@@ -1,5 +1,6 @@
 #include "core/photonMap.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace volphoton {
@@ -10,7 +11,7 @@ struct QueryContext {
     const PhotonMap* map;
     const std::vector<Photon>* photons;
     const Ray* ray;
-    double tMin, tMax, r2;
+    double tMin, tMax;
     FunctionRef<void(const Photon&, double, double)>* visit;
 };
 
@@ -26,7 +27,7 @@ void gatherFilter(const RTCFilterFunctionNArguments* args) {
         double t = dot(oc, ctx->ray->d);
         if (t < ctx->tMin || t > ctx->tMax) continue;
         double d2 = std::max(0.0, lengthSquared(oc) - t * t);
-        if (d2 > ctx->r2) continue;
+        if (d2 > double(ph.radius) * ph.radius) continue;
         (*ctx->visit)(ph, t, d2);
     }
 }
@@ -36,6 +37,9 @@ PhotonMap::PhotonMap(std::vector<Photon> photons, double radius) : photons_(std:
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw std::runtime_error("cannot create an Embree device for the photon map");
     scene_ = rtcNewScene(device_);
+    // Floor: a radius of 0 (a cap below float's range) would divide by zero in the kernel.
+    const float rMax = static_cast<float>(radius), rMin = static_cast<float>(1e-6 * radius);
+    for (Photon& ph : photons_) ph.radius = std::isnan(ph.radius) ? rMax : std::clamp(ph.radius, rMin, rMax);
     if (!photons_.empty()) {
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_DISC_POINT);
         float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), photons_.size()));
@@ -43,7 +47,7 @@ PhotonMap::PhotonMap(std::vector<Photon> photons, double radius) : photons_(std:
             v[4 * i] = photons_[i].p[0];
             v[4 * i + 1] = photons_[i].p[1];
             v[4 * i + 2] = photons_[i].p[2];
-            v[4 * i + 3] = static_cast<float>(radius * 1.001);  // float slack; the exact test is in the filter
+            v[4 * i + 3] = photons_[i].radius * 1.001f;  // float slack; the exact test is in the filter
         }
         rtcSetGeometryIntersectFilterFunction(g, gatherFilter);
         rtcCommitGeometry(g);
@@ -67,7 +71,6 @@ void PhotonMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<void
     ctx.ray = &ray;
     ctx.tMin = tMin;
     ctx.tMax = tMax;
-    ctx.r2 = radius_ * radius_;
     ctx.visit = &visit;
     // Embree skips discs closer to the ray origin than a multiple of their radius (its curve
     // self-intersection avoidance, EMBREE_CURVE_SELF_INTERSECTION_AVOIDANCE_FACTOR), so the query ray

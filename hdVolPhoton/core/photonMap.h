@@ -22,6 +22,11 @@ struct Photon {
     float power[3];
     const PhaseFunction* phase;
     int region;  ///< innermost medium mesh at the photon (-1: outside every mesh)
+    /// Kernel radius of this photon. The tracer stores a cap tied to the local mean free path; the map
+    /// lowers it to the pass radius. Each disc's kernel integrates to one over its own area, so
+    /// per-photon radii keep the estimate's energy (a sample-point kernel estimate; Jarosz et al. 2008
+    /// use per-photon radii too).
+    float radius;
 };
 
 /// \class PhotonMap
@@ -33,9 +38,10 @@ public:
     PhotonMap(const PhotonMap&) = delete;
     PhotonMap& operator=(const PhotonMap&) = delete;
 
-    /// Calls visit(photon, t along the ray, squared distance to the ray) for every photon within the
-    /// radius of the segment ray.o + t ray.d, t in [tMin, tMax].
+    /// Calls visit(photon, t along the ray, squared distance to the ray) for every photon whose own
+    /// radius (Photon::radius, at most radius()) reaches the segment ray.o + t ray.d, t in [tMin, tMax].
     void query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const Photon&, double, double)> visit) const;
+    /// The pass radius: the largest photon radius.
     double radius() const { return radius_; }
     size_t size() const { return photons_.size(); }
     size_t bytes() const { return photons_.size() * BytesPerPhoton; }

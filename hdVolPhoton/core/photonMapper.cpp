@@ -73,6 +73,7 @@ public:
         uint64_t traced = 0;
         if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel)) return false;
         stats.photonsThinned += thinToBudget(pass, &photons);
+        noteNarrowKernels(photons, r, stats);
         map_ = std::make_unique<PhotonMap>(std::move(photons), r);
         stats.photonsTraced += traced;
         stats.photonsStored += map_->size();
@@ -219,6 +220,24 @@ private:
                 double sigmaHere = seg.decay == 0 ? seg.sigmaMaj : seg.sigmaMaj * std::exp(std::min(-seg.decay * (t0 - seg.tMin), 700.0));
                 double dt = std::min({step_, 0.25 / sigmaHere, seg.tMax - t0});
                 if (seg.decay < 0) dt = std::min(dt, 0.25 / (sigmaHere * std::exp(std::min(-seg.decay * dt, 700.0))));
+                if (!(t0 + dt > t0)) {
+                    // The step is below the floating-point resolution of t (a density near the 1e300
+                    // clamp): the march cannot advance, and the medium is opaque here at this precision.
+                    // Close the segment with the step integral of a homogeneous layer,
+                    // int_0^inf x e^{-sigma_t s} ds = x / sigma_t per channel, and stop (T = 0).
+                    // Summing x T dt over steps that do not move would add up without bound.
+                    MediumProperties mp = media.properties(ray.at(t0));
+                    Spectrum sigma_t = mp.sigma_t();
+                    Spectrum T = tr.closedForm ? tr.at(t0) : exp(-tauRun);
+                    Spectrum invSigma;
+                    for (int c = 0; c < 3; ++c) invSigma[c] = sigma_t[c] > 0 ? 1 / sigma_t[c] : 0.0;
+                    if (!sigma_t.isBlack()) r.interacted = true;
+                    if (emissive) r.emission += mp.emission * invSigma * T * weight;
+                    if (single && hasExtended_ && !mp.sigma_s.isBlack())
+                        r.single += directExtended(ray.at(t0), ray.d, mp, stack, rng) * invSigma * T * weight;
+                    stop = true;
+                    break;
+                }
                 double t = t0 + offsetU * dt;
                 t0 += dt;
                 Vec3 p = ray.at(t);
@@ -301,12 +320,23 @@ private:
         return tr.at(t) * f * T * ls.Li / (ls.pdf * pdf);
     }
 
+    /// A photon's kernel radius cap: settings.photonRadiusMfp mean free paths at the photon. A disc far
+    /// wider than the mean free path lets camera segments that pass outside an optically thick layer
+    /// gather the photons of its skin with their own transmittance (~1) instead of the photons' (~0):
+    /// an energy gain without bound as the layer gets denser (tools/stress.py, exponential media with
+    /// a = 1e6). The cap keeps the kernel inside the region the photon's light actually reaches.
+    /// (PhotonMap clamps it to [1e-6, 1] x the pass radius.)
+    float radiusCap(double sigmaTMax) const {
+        if (!(settings_.photonRadiusMfp > 0) || !(sigmaTMax > 0)) return std::numeric_limits<float>::infinity();
+        return static_cast<float>(settings_.photonRadiusMfp / sigmaTMax);
+    }
+
     Spectrum gather(const Ray& ray, double a, double b, const SegmentTransmittance& tr, const MediumStack& stack) const {
         Spectrum sum;
         int region = stack.innermost();
-        double invArea = 1 / (Pi * map_->radius() * map_->radius());
         map_->query(ray, a, b, [&](const Photon& ph, double t, double) {
             if (ph.region != region) return;
+            double invArea = 1 / (Pi * double(ph.radius) * ph.radius);
             double cosTheta = -(ph.dir[0] * ray.d.x + ph.dir[1] * ray.d.y + ph.dir[2] * ray.d.z);
             double p = ph.phase->eval(std::clamp(cosTheta, -1.0, 1.0));
             sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * tr.at(t) * (p * invArea);
@@ -448,6 +478,7 @@ private:
                     }
                     ph.phase = mp.lobes[lobe].phase;
                     ph.region = stack.innermost();
+                    ph.radius = radiusCap(mp.sigma_t().maxValue());
                     out->push_back(ph);
                 }
                 ++events;
@@ -494,6 +525,27 @@ private:
             }
             ray = s.next;
             tMin = s.tMin;
+        }
+    }
+
+    /// Counts the photons whose mean-free-path cap narrows their kernel below the pass radius r, and
+    /// warns once per render when more than a tenth of them are narrowed below r / 100: there the
+    /// multiple-scattering estimate is right on average but very noisy (often dark until many passes
+    /// have run), so the picture must not look converged silently.
+    void noteNarrowKernels(const std::vector<Photon>& photons, double r, RenderStats& stats) {
+        size_t capped = 0, narrow = 0;
+        for (const Photon& ph : photons) {
+            capped += ph.radius < r;
+            narrow += ph.radius < 0.01 * r;
+        }
+        stats.photonsRadiusCapped += capped;
+        if (!warnedNarrow_ && narrow * 10 > photons.size()) {
+            warnedNarrow_ = true;
+            warn("photonMap integrator: " + std::to_string(100 * narrow / photons.size()) +
+                 "% of the photons lie in media whose mean free path is below 1/100 of the photon radius (" +
+                 std::to_string(r) + "); their kernels shrink to photonRadiusMfp mean free paths, so multiple "
+                 "scattering there stays noisy and dark until many photons have been traced. The path "
+                 "tracer handles such optically thick media better.");
         }
     }
 
@@ -561,6 +613,7 @@ private:
     }
 
     double radius_, step_;
+    bool warnedNarrow_ = false;
     std::vector<int> pointLights_;
     Distribution1D extendedDist_;
     std::vector<Emitter> emitters_;

@@ -115,6 +115,7 @@ py::dict statsToDict(const RenderStats& s) {
     d["multiple_to_single_ratio"] = s.multipleToSingleRatio;
     d["photon_map_bytes"] = s.photonMapBytes;
     d["photons_thinned"] = s.photonsThinned;
+    d["photons_radius_capped"] = s.photonsRadiusCapped;
     d["passes_run"] = s.passesRun;
     d["passes_skipped"] = s.passesSkipped;
     d["cancelled"] = s.cancelled;
@@ -134,6 +135,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["photonsPerPass"] = s.photonsPerPass;
     d["initialRadius"] = s.initialRadius;
     d["radiusAlpha"] = s.radiusAlpha;
+    d["photonRadiusMfp"] = s.photonRadiusMfp;
     d["marchStep"] = s.marchStep;
     d["singleScattering"] = s.singleScattering;
     d["multipleScattering"] = s.multipleScattering;
@@ -642,6 +644,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("photons_per_pass", &RenderSettings::photonsPerPass)
         .def_readwrite("initial_radius", &RenderSettings::initialRadius)
         .def_readwrite("radius_alpha", &RenderSettings::radiusAlpha)
+        .def_readwrite("photon_radius_mfp", &RenderSettings::photonRadiusMfp)
         .def_readwrite("march_step", &RenderSettings::marchStep)
         .def_readwrite("single_scattering", &RenderSettings::singleScattering)
         .def_readwrite("multiple_scattering", &RenderSettings::multipleScattering)

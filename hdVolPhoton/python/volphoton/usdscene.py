@@ -139,6 +139,7 @@ SETTINGS_ATTRIBUTES = {
     "photonsPerPass": ("photons_per_pass", int),
     "initialRadius": ("initial_radius", float),
     "radiusAlpha": ("radius_alpha", float),
+    "photonRadiusMfp": ("photon_radius_mfp", float),
     "marchStep": ("march_step", float),
     "singleScattering": ("single_scattering", bool),
     "multipleScattering": ("multiple_scattering", bool),
