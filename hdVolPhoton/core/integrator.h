@@ -15,8 +15,9 @@
 // |                     |        |            |              | the scene diameter)                               |
 // | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
 // | photonRadiusMfp     | double | 1          | mean free    | photonMap: a photon's radius is at most this many |
-// |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon;    |
-// |                     |        |            |              | 0: no cap (the pass radius for every photon)      |
+// |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
+// |                     |        |            |              | for media not bounded by a closed mesh (inside one|
+// |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
 // |                     |        |            |              | the scene diameter)                               |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |

@@ -325,6 +325,9 @@ private:
     /// gather the photons of its skin with their own transmittance (~1) instead of the photons' (~0):
     /// an energy gain without bound as the layer gets denser (tools/stress.py, exponential media with
     /// a = 1e6). The cap keeps the kernel inside the region the photon's light actually reaches.
+    /// Only photons outside every closed medium mesh get it: inside one, gathering is already limited
+    /// to the mesh's interior (Photon::region), so no camera segment passes outside such a medium
+    /// within its kernel, and an explicit wide radius (a laterally uniform slab) keeps its low noise.
     /// (PhotonMap clamps it to [1e-6, 1] x the pass radius.)
     float radiusCap(double sigmaTMax) const {
         if (!(settings_.photonRadiusMfp > 0) || !(sigmaTMax > 0)) return std::numeric_limits<float>::infinity();
@@ -478,7 +481,7 @@ private:
                     }
                     ph.phase = mp.lobes[lobe].phase;
                     ph.region = stack.innermost();
-                    ph.radius = radiusCap(mp.sigma_t().maxValue());
+                    ph.radius = ph.region < 0 ? radiusCap(mp.sigma_t().maxValue()) : std::numeric_limits<float>::infinity();
                     out->push_back(ph);
                 }
                 ++events;
