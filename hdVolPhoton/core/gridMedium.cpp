@@ -207,9 +207,18 @@ BadValues scanValues(TreeT& tree) {
 
 // ---- majorant grid -----------------------------------------------------------------------------
 
-/// Slack, in voxels, added to each value's reach so that rounding in the DDA's cell attribution
-/// (of order 1e-12 voxels) can never put a point where its stencil's maximum is not counted.
-constexpr double ReachSlack = 1e-3;
+/// Inset, in voxels, of each value's reach (-1, +1 around its voxel centre). The closed reach would
+/// also touch the cells that only share its boundary, where the value's trilinear weight is 0: at a
+/// dense grid's edge those cells (a full cell layer on every side) then carried the edge's majorant
+/// over empty space, ~1e4 null collisions per crossing at the density clamp. A point the DDA
+/// attributes to such a cell by rounding (~1e-12 voxels from the boundary) gives the value a weight
+/// of that order, far below the collision tests' resolution.
+constexpr double ReachInset = 1e-9;
+
+/// Densities are clamped where one voxel's optical depth would exceed this (see the constructor).
+constexpr double MaxVoxelOpticalDepth = 1e4;
+/// Target optical depth of one majorant cell at the grid's largest density (finer cells below it).
+constexpr double MaxCellOpticalDepth = 64;
 
 /// Fills `grid` with, per cell, the maximum of every stored value whose trilinear reach (the open
 /// cube of half-width 1 voxel around the voxel centre) overlaps the cell, plus the background.
@@ -225,8 +234,8 @@ void fillMajorants(const FloatTree& tree, MajorantGrid& grid) {
         if (!(v > bg)) continue;
         openvdb::CoordBBox b;
         tile.getBoundingBox(b);
-        Bounds3 reach{{b.min().x() - 1 - ReachSlack, b.min().y() - 1 - ReachSlack, b.min().z() - 1 - ReachSlack},
-                      {b.max().x() + 1 + ReachSlack, b.max().y() + 1 + ReachSlack, b.max().z() + 1 + ReachSlack}};
+        Bounds3 reach{{b.min().x() - 1 + ReachInset, b.min().y() - 1 + ReachInset, b.min().z() - 1 + ReachInset},
+                      {b.max().x() + 1 - ReachInset, b.max().y() + 1 - ReachInset, b.max().z() + 1 - ReachInset}};
         grid.raiseBox(reach, v);
     }
 
@@ -248,7 +257,7 @@ void fillMajorants(const FloatTree& tree, MajorantGrid& grid) {
             for (int a = 0; a < 3; ++a)
                 for (int l = 0; l < D; ++l) {
                     double i = origin[a] + l;
-                    inside[a][l] = grid.cellRange(a, i - 1 - ReachSlack, i + 1 + ReachSlack, &c0[a][l], &c1[a][l]);
+                    inside[a][l] = grid.cellRange(a, i - 1 + ReachInset, i + 1 - ReachInset, &c0[a][l], &c1[a][l]);
                     if (inside[a][l]) {
                         lo[a] = std::min(lo[a], c0[a][l]);
                         hi[a] = std::max(hi[a], c1[a][l]);
@@ -335,6 +344,7 @@ struct GridMedium::Impl {
     double majorantSeconds = 0;
     size_t activeVoxels = 0;
     double maxDensity = 0;
+    double densityCap = Infinity;  // densities are clamped here (MaxVoxelOpticalDepth per voxel)
     double maxAlbedoGrid = 1;    // max of the albedo grid, clamped to [0, 1]
     double maxEmissionGrid = 1;  // max of the emission grid
     double maxTemperature = 0;   // max of the temperature grid (grid units)
@@ -478,9 +488,33 @@ GridMedium::GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids,
         m.support.lo = Vec3(bbox.min().x() - 1.0, bbox.min().y() - 1.0, bbox.min().z() - 1.0);
         m.support.hi = Vec3(bbox.max().x() + 1.0, bbox.max().y() + 1.0, bbox.max().z() + 1.0);
         auto start = std::chrono::steady_clock::now();
-        std::array<int, 3> res = MajorantGrid::resolutionFor(m.support, 8.0, 128);
+        // Optical depth across one voxel at the grid's largest density. Beyond MaxVoxelOpticalDepth a
+        // voxel is opaque at any precision that matters (T = e^-1e4), so the density is clamped
+        // there: delta tracking through the trilinear ramp at a dense edge then costs ~sqrt(2 x 1e4)
+        // null collisions instead of a number that grows with the density (a VDB of 3e38 never
+        // finished). Dense grids also get finer majorant cells, so that crossing a cell costs at most
+        // ~MaxCellOpticalDepth tentative collisions even where its stencil is mostly empty.
+        const Impl::Field& dens = m.fields[DensityField];
+        const double voxel = std::min({length(dens.indexToWorld.vector(Vec3(1, 0, 0))),
+                                       length(dens.indexToWorld.vector(Vec3(0, 1, 0))),
+                                       length(dens.indexToWorld.vector(Vec3(0, 0, 1)))});
+        const double sigmaPerDensity = desc.densityScale * desc.extinctionColor.maxValue();
+        const double maxValue = gridMaxValue(tree);
+        double voxelDepth = maxValue * sigmaPerDensity * voxel;
+        if (voxelDepth > MaxVoxelOpticalDepth) {
+            m.densityCap = MaxVoxelOpticalDepth / (sigmaPerDensity * voxel);
+            std::ostringstream msg;
+            msg << "grid " << quote(dens.name) << " of " << quote(m.source) << ": density " << maxValue << " x scale "
+                << desc.densityScale << " reaches an optical depth of " << voxelDepth << " across one voxel; clamped to "
+                << MaxVoxelOpticalDepth << " per voxel (density " << m.densityCap << "), which is opaque either way";
+            warn(msg.str());
+            voxelDepth = MaxVoxelOpticalDepth;
+        }
+        const double voxelsPerCell = std::clamp(MaxCellOpticalDepth / std::max(voxelDepth, 1e-300), 1.0, 8.0);
+        std::array<int, 3> res = MajorantGrid::resolutionFor(m.support, voxelsPerCell, voxelsPerCell < 8 ? 256 : 128);
         m.majorant = MajorantGrid(m.support, res[0], res[1], res[2]);
         fillMajorants(tree, m.majorant);
+        if (m.densityCap < Infinity) m.majorant.capAll(static_cast<float>(m.densityCap));
         m.majorantSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         m.maxDensity = m.majorant.maxValue();
     }
@@ -504,7 +538,7 @@ double GridMedium::density(const Vec3& p) const {
     if (m.support.empty()) return 0;
     Vec3 pi = m.fields[DensityField].worldToIndex.point(p);
     if (!m.support.contains(pi)) return 0;
-    return sampleTrilinear(*m.accessors().acc[DensityField], pi);
+    return std::min(sampleTrilinear(*m.accessors().acc[DensityField], pi), m.densityCap);
 }
 
 MediumProperties GridMedium::properties(const Vec3& p) const {
@@ -514,7 +548,7 @@ MediumProperties GridMedium::properties(const Vec3& p) const {
     const Vec3 pi = m.fields[DensityField].worldToIndex.point(p);
     if (!m.support.contains(pi)) return mp;
     Impl::AccessorCache& cache = m.accessors();
-    const double d = sampleTrilinear(*cache.acc[DensityField], pi);
+    const double d = std::min(sampleTrilinear(*cache.acc[DensityField], pi), m.densityCap);
     if (!(d > 0)) return mp;
 
     const Spectrum sigma_t = m.sigmaTPerDensity * d;

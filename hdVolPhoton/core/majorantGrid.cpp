@@ -75,6 +75,10 @@ void MajorantGrid::raiseAll(float v) {
     for (float& c : cells_) c = std::max(c, v);
 }
 
+void MajorantGrid::capAll(float v) {
+    for (float& c : cells_) c = std::min(c, v);
+}
+
 void MajorantGrid::walk(const Vec3& o, const Vec3& d, double tMin, double tMax, WalkCallback cb) const {
     if (cells_.empty() || !(tMin < tMax)) return;
     // Clip [tMin, tMax] to the box (slab test). An axis with d = 0 leaves t alone when the origin

@@ -9,7 +9,7 @@
 // | voxelsPerCell  | double | 8       | resolutionFor(): target cell width in local units (voxels)     |
 // | maxCells       | int    | 128     | resolutionFor(): cap on cells per axis                         |
 //
-// Cells start at 0; raise()/raiseBox() only ever increase them, so a build may raise cells
+// Cells start at 0; raise()/raiseBox() only ever increase them (capAll() lowers them after a build), so a build may raise cells
 // concurrently through raiseAtomic(). Cell values must be >= 0 (maxima of non-negative fields).
 #pragma once
 
@@ -64,6 +64,8 @@ public:
     void raiseBox(const Bounds3& b, float v);
     /// Raises every cell to >= v.
     void raiseAll(float v);
+    /// Lowers every cell to <= v, after the build: for a field clamped at v where it is sampled.
+    void capAll(float v);
 
     /// Walks the ray o + t d (local space; d need not be unit length, so t stays the parameter of
     /// the caller's ray through an affine map) over [tMin, tMax] clipped to the box, calling `cb` in

@@ -251,7 +251,18 @@ private:
                 }
                 if (!sigma_t.isBlack()) r.interacted = true;
                 if (emissive) r.emission += mp.emission * T * (dt * weight);
-                if (single && hasExtended_ && !mp.sigma_s.isBlack()) r.single += directExtended(p, ray.d, mp, stack, rng) * T * (dt * weight);
+                if (single && hasExtended_ && !mp.sigma_s.isBlack()) {
+                    // Light sampling costs a shadow ray. Steps whose weight sigma_s T dt is tiny (the
+                    // march resolves the majorant, so at a dense grid's edge thousands of steps cross
+                    // a ramp of little density) sample it with probability weight / NeeWeight and
+                    // divide by that probability: unbiased, and ordinary steps (weight >= 1e-3) are
+                    // unaffected.
+                    constexpr double NeeWeight = 1e-3;
+                    double stepWeight = (mp.sigma_s * T).maxValue() * dt * weight;
+                    double q = std::min(1.0, stepWeight / NeeWeight);
+                    if (q >= 1 || rng.uniform() < q)
+                        r.single += directExtended(p, ray.d, mp, stack, rng) * T * (dt * weight / q);
+                }
                 // Early termination of the march.
                 double Tmax = T.maxValue() * weight;
                 if (Tmax < settings_.transmittanceCutoff) { stop = true; break; }

@@ -15,9 +15,11 @@
 #include <openvdb/openvdb.h>
 
 #include "core/diagnostics.h"
+#include "core/freeFlight.h"
 #include "core/gridMedium.h"
 #include "core/majorantGrid.h"
 #include "core/rng.h"
+#include "core/sampling.h"
 
 using namespace volphoton;
 using openvdb::Coord;
@@ -388,6 +390,48 @@ TEST(GridMajorant, NonZeroBackgroundIsBoundedInsideSupport) {
     ASSERT_FALSE(segs.empty());
     for (const auto& s : segs) EXPECT_GE(s.sigmaMaj, 0.25);
     checkMajorantsBoundDensity(medium, 23, 100);
+}
+
+TEST(GridMajorant, EnormousDensitiesAreClampedAndCheapToCross) {
+    // A 16^3 block of density 1e30 (voxel 1/32): one voxel's optical depth would be 3e28. The density
+    // is clamped to an optical depth of 1e4 per voxel (opaque either way) with a warning, and a free
+    // flight into the block costs about sqrt(2 x 1e4) ~ 140 tentative collisions in the trilinear ramp
+    // at its face. (Before: no clamp, and majorant cells one layer beyond the block at full value, so
+    // flights ran into the 2^20 truncation; stress cases 250/251 and the 3e38 VDB took hours.)
+    FloatGrid::Ptr grid = FloatGrid::create(0.0f);
+    auto acc = grid->getAccessor();
+    for (int i = 0; i < 16; ++i)
+        for (int j = 0; j < 16; ++j)
+            for (int k = 0; k < 16; ++k) acc.setValue(Coord(i, j, k), 1e30f);
+    // Thin haze voxels at two far corners: the block sits inside the support with empty space around.
+    acc.setValue(Coord(-24, -24, -24), 1e-3f);
+    acc.setValue(Coord(40, 40, 40), 1e-3f);
+    const double voxel = 1.0 / 32;
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(voxel));
+    CaptureDiagnostics capture;
+    GridMedium medium(GridMediumDesc{}, GridMediumGrids{grid});
+    ASSERT_EQ(capture.messages.size(), 1u);
+    EXPECT_NE(capture.messages[0].find("clamped to 10000 per voxel"), std::string::npos) << capture.messages[0];
+    const double cap = 1e4 / voxel;
+    EXPECT_NEAR(medium.properties(Vec3(0.25, 0.25, 0.25)).sigma_t().maxValue(), cap, 1e-6 * cap);
+    Rng rng(7);
+    int64_t total = 0;
+    const int rays = 2000;
+    for (int n = 0; n < rays; ++n) {
+        // From outside, towards a random point of the block, from a random direction.
+        Vec3 target = Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (15 * voxel);
+        Vec3 d = uniformSphere(rng.uniform(), rng.uniform());
+        Ray r{target - d * 2.0, d};
+        int64_t events = 0;
+        FlightEnd end = sampleFreeFlight(medium, r, 4.0, rng, [&](const MediumEvent& e) {
+            ++events;
+            EXPECT_LE(e.mp.sigma_t().maxValue(), e.sigmaMaj * (1 + 1e-9));
+            return rng.uniform() >= e.mp.sigma_t().maxValue() / e.sigmaMaj;  // null: go on
+        });
+        EXPECT_NE(end, FlightEnd::Truncated);
+        total += events;
+    }
+    EXPECT_LT(double(total) / rays, 1000.0) << "mean tentative collisions per flight";
 }
 
 // ---- loading errors ----------------------------------------------------------------------------
