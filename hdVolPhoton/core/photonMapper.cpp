@@ -255,9 +255,9 @@ private:
                     // Light sampling costs a shadow ray. Steps whose weight sigma_s T dt is tiny (the
                     // march resolves the majorant, so at a dense grid's edge thousands of steps cross
                     // a ramp of little density) sample it with probability weight / NeeWeight and
-                    // divide by that probability: unbiased, and ordinary steps (weight >= 1e-3) are
+                    // divide by that probability: unbiased, and ordinary steps (weight >= 1e-5) are
                     // unaffected.
-                    constexpr double NeeWeight = 1e-3;
+                    constexpr double NeeWeight = 1e-5;
                     double stepWeight = (mp.sigma_s * T).maxValue() * dt * weight;
                     double q = std::min(1.0, stepWeight / NeeWeight);
                     if (q >= 1 || rng.uniform() < q)
