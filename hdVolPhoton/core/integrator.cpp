@@ -167,6 +167,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     if (settings_.maxDepth < 0) throw std::invalid_argument("render settings: maxDepth must be >= 0");
     if (settings_.photonsPerPass < 0) throw std::invalid_argument("render settings: photonsPerPass must be >= 0");
     if (!(settings_.radiusAlpha > 0 && settings_.radiusAlpha <= 1)) throw std::invalid_argument("render settings: radiusAlpha must be in (0, 1]");
+    if (settings_.stratifiedDims < 0) throw std::invalid_argument("render settings: stratifiedDims must be >= 0");
     if (!(settings_.photonRadiusMfp >= 0)) throw std::invalid_argument("render settings: photonRadiusMfp must be >= 0");
     integrator_ = settings_.integrator == RenderSettings::Integrator::PhotonMap ? makePhotonMapper(*scene_, settings_)
                                                                                : makePathTracer(*scene_, settings_);
@@ -200,6 +201,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                 for (int y = ty * tile; y < std::min(settings_.height, (ty + 1) * tile); ++y)
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
                         Rng rng(hashKeys(x, y, settings_.seed), static_cast<uint64_t>(pass_));
+                        rng.stratify(static_cast<uint32_t>(pass_), hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
                         double tMin, tMax;
                         Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
                         PathRadiance L = integrator_->Li(ray, tMin, tMax, rng);

@@ -9,6 +9,9 @@
 // | maxDepth            | int    | 64         |              | scattering/bounce events per path                 |
 // | rouletteDepth       | int    | 3          |              | events before Russian roulette may end a path     |
 // | seed                | uint64 | 0          |              | every random stream hashes (pixel, pass, seed)    |
+// | stratifiedDims      | int    | 32         |              | draws per camera sample taken from scrambled      |
+// |                     |        |            |              | Sobol' points over the passes (Rng::stratify);    |
+// |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
 // | photonsPerPass      | int    | 100000     |              | photonMap: photons traced per pass               |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
@@ -69,6 +72,7 @@ struct RenderSettings {
     double initialRadius = 0;
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 1;
+    int stratifiedDims = 32;
     double marchStep = 0;
     bool singleScattering = true;
     bool multipleScattering = true;

@@ -25,7 +25,74 @@ uint64_t hashKeys(Ts... keys) {
     return h;
 }
 
+/// Bits of x in reverse order.
+inline uint32_t reverseBits32(uint32_t x) {
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+    x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+    x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+    return x;
+}
+
+/// The Laine-Karras permutation with the constants of Burley 2020 ("Practical Hash-based Owen
+/// Scrambling", JCGT 9(4)): applied to a bit-reversed value it is an Owen (nested uniform) scramble,
+/// a bijection that maps every base-2 elementary interval onto one, so a (0, m, 2)-net stays a net.
+inline uint32_t laineKarras(uint32_t x, uint32_t seed) {
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+/// Owen scrambling of a 32-bit fixed-point value.
+inline uint32_t owenScramble(uint32_t x, uint32_t seed) { return reverseBits32(laineKarras(reverseBits32(x), seed)); }
+
+/// The first two dimensions of the Sobol' sequence as 32-bit fixed point: van der Corput and the
+/// second Sobol' generator matrix (v_1 = 2^31, v_{k+1} = v_k ^ (v_k >> 1)). Together a (0, 2)-sequence:
+/// every power-of-two prefix stratifies the unit square into every elementary interval.
+inline uint32_t sobol0(uint32_t i) { return reverseBits32(i); }
+namespace detail {
+/// Byte tables of the second matrix. plain: t[k][b] = XOR of the columns of the set bits of b << 8k.
+/// reversed: indexed by the bit-reversed index, giving the bit-reversed value (what Owen scrambling
+/// works on), so the sampler below needs no reversal for that dimension.
+struct Sobol1Tables {
+    uint32_t plain[4][256], reversed[4][256];
+    static constexpr uint32_t rev(uint32_t x) {
+        uint32_t r = 0;
+        for (int j = 0; j < 32; ++j) r |= ((x >> j) & 1u) << (31 - j);
+        return r;
+    }
+    constexpr Sobol1Tables() : plain(), reversed() {
+        uint32_t col[32] = {};
+        uint32_t v = 1u << 31;
+        for (int j = 0; j < 32; ++j, v ^= v >> 1) col[j] = v;
+        for (int k = 0; k < 4; ++k)
+            for (int b = 0; b < 256; ++b) {
+                uint32_t p = 0, r = 0;
+                for (int j = 0; j < 8; ++j)
+                    if (b & (1 << j)) {
+                        p ^= col[8 * k + j];
+                        r ^= rev(col[31 - (8 * k + j)]);  // bit 8k+j of the reversed index is bit 31-(8k+j) of the index
+                    }
+                plain[k][b] = p;
+                reversed[k][b] = r;
+            }
+    }
+};
+inline constexpr Sobol1Tables kSobol1{};
+inline uint32_t lookup(const uint32_t (&t)[4][256], uint32_t i) {
+    return t[0][i & 0xff] ^ t[1][(i >> 8) & 0xff] ^ t[2][(i >> 16) & 0xff] ^ t[3][i >> 24];
+}
+}  // namespace detail
+inline uint32_t sobol1(uint32_t i) { return detail::lookup(detail::kSobol1.plain, i); }
+/// reverseBits32(sobol1(reverseBits32(r))), without the reversals.
+inline uint32_t sobol1Reversed(uint32_t r) { return detail::lookup(detail::kSobol1.reversed, r); }
+
 /// PCG32 (O'Neill 2014, pcg-random.org): 64-bit state, 32-bit output, selectable stream.
+/// With stratify(), the first draws of a camera sample come from a randomised quasi-Monte Carlo
+/// sequence instead (see there); after them, and in every other stream, PCG32.
 class Rng {
 public:
     Rng() { seed(0, 0); }
@@ -46,12 +113,45 @@ public:
     }
     /// Uniform in [0, 1): 53 random bits from two draws, so the value is never rounded up to 1.
     double uniform() {
+        if (qmcDim_ < qmcDims_) return stratified();
         uint64_t hi = nextU32() >> 5, lo = nextU32() >> 6;  // 27 + 26 bits
         return static_cast<double>((hi << 26) | lo) * (1.0 / 9007199254740992.0);
     }
 
+    /// Makes the next `dims` draws sample `sampleIndex` of a padded, shuffled, Owen-scrambled 2D
+    /// Sobol' sequence (Burley 2020, sec. 4; pbrt-v4's PaddedSobolSampler is the same design): draws
+    /// 2k and 2k+1 are a (0, 2)-sequence over the sample index, its index shuffled and its values
+    /// scrambled by hashes of (key, k). Each sample is still uniform on the unit hypercube (so every
+    /// estimate stays unbiased and seeds stay independent), but the samples of one pixel over its
+    /// passes stratify each pair of dimensions: the first bounce's pixel position, light and BSDF
+    /// choices converge at up to O(1/N) instead of O(1/sqrt N). Samples of one pixel are therefore
+    /// not independent: estimate errors from several seeds, not from the spread of one render's passes.
+    void stratify(uint32_t sampleIndex, uint64_t key, int dims) {
+        qmcIndexReversed_ = reverseBits32(sampleIndex);
+        qmcKey_ = key;
+        qmcDim_ = 0;
+        qmcDims_ = dims;
+    }
+
 private:
+    double stratified() {
+        int pair = qmcDim_ >> 1;
+        if ((qmcDim_ & 1) == 0) {
+            // Shuffled index i = owenScramble(index) = reverse(r); values owenScramble(sobol0(i)) and
+            // owenScramble(sobol1(i)), with the bit reversals that cancel left out.
+            uint64_t h = mix64(qmcKey_ + static_cast<uint64_t>(pair + 1) * 0x9e3779b97f4a7c15ULL);
+            uint32_t r = laineKarras(qmcIndexReversed_, static_cast<uint32_t>(h));
+            qmcPair_[0] = reverseBits32(laineKarras(reverseBits32(r), static_cast<uint32_t>(h >> 32)));
+            qmcPair_[1] = reverseBits32(laineKarras(sobol1Reversed(r), static_cast<uint32_t>(mix64(h))));
+        }
+        uint32_t v = qmcPair_[qmcDim_++ & 1];
+        return v * (1.0 / 4294967296.0);
+    }
+
     uint64_t state_, inc_;
+    uint64_t qmcKey_ = 0;
+    uint32_t qmcIndexReversed_ = 0, qmcPair_[2] = {0, 0};
+    int qmcDim_ = 0, qmcDims_ = 0;
 };
 
 }  // namespace volphoton

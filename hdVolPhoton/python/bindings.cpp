@@ -136,6 +136,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["initialRadius"] = s.initialRadius;
     d["radiusAlpha"] = s.radiusAlpha;
     d["photonRadiusMfp"] = s.photonRadiusMfp;
+    d["stratifiedDims"] = s.stratifiedDims;
     d["marchStep"] = s.marchStep;
     d["singleScattering"] = s.singleScattering;
     d["multipleScattering"] = s.multipleScattering;
@@ -645,6 +646,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("initial_radius", &RenderSettings::initialRadius)
         .def_readwrite("radius_alpha", &RenderSettings::radiusAlpha)
         .def_readwrite("photon_radius_mfp", &RenderSettings::photonRadiusMfp)
+        .def_readwrite("stratified_dims", &RenderSettings::stratifiedDims)
         .def_readwrite("march_step", &RenderSettings::marchStep)
         .def_readwrite("single_scattering", &RenderSettings::singleScattering)
         .def_readwrite("multiple_scattering", &RenderSettings::multipleScattering)

@@ -38,10 +38,10 @@ CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov = 0.6) 
 
 /// Renders one image per seed and returns per-pixel beauty channel c (or an AOV) for each seed.
 std::vector<std::vector<float>> renderSeeds(const std::function<SceneDesc()>& makeScene, RenderSettings s, Film::Aov aov = Film::Beauty,
-                                            int channel = 0) {
+                                            int channel = 0, int seeds = Seeds) {
     auto scene = std::make_shared<Scene>(makeScene());
     std::vector<std::vector<float>> out;
-    for (int seed = 0; seed < Seeds; ++seed) {
+    for (int seed = 0; seed < seeds; ++seed) {
         s.seed = static_cast<uint64_t>(seed);
         Renderer r(scene, s);
         r.render();
@@ -126,8 +126,13 @@ TEST(IntegratorFurnace, ChromaticExponentialMedium) {
         return furnaceScene(std::make_shared<ExponentialMedium>(c, 1.0, 1.5, Vec3(0, -1, 0), Vec3(0, 1, 0), Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}),
                             Vec3(0.5, 0.5, 3.0));
     };
+    // 64 seeds: spectral tracking's weights in a chromatic medium are heavy-tailed (rare paths carry
+    // large per-channel weights), and with stratified camera samples (Rng::stratify) the bulk of
+    // each seed's estimate is so smooth that 16 seeds' standard error misses the tail (pixel means
+    // 5 standard errors low at 16 and 32 seeds, within 3 at 64; the image mean at 64 seeds is
+    // within 1 standard error of 1).
     for (int ch = 0; ch < 3; ++ch)
-        expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PathTracer, 8, 0), Film::Beauty, ch), 1.0, 5, 1e-9,
+        expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PathTracer, 8, 0), Film::Beauty, ch, 64), 1.0, 5, 1e-9,
                          "exponential furnace channel " + std::to_string(ch));
     for (int ch = 0; ch < 3; ++ch)
         expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0), Film::Beauty, ch), 1.0, 5, 0.02,

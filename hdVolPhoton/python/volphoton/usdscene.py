@@ -140,6 +140,7 @@ SETTINGS_ATTRIBUTES = {
     "initialRadius": ("initial_radius", float),
     "radiusAlpha": ("radius_alpha", float),
     "photonRadiusMfp": ("photon_radius_mfp", float),
+    "stratifiedDims": ("stratified_dims", int),
     "marchStep": ("march_step", float),
     "singleScattering": ("single_scattering", bool),
     "multipleScattering": ("multiple_scattering", bool),
