@@ -71,8 +71,7 @@ public:
         for (int i = 0; i < pass; ++i) r *= std::sqrt((i + settings_.radiusAlpha) / (i + 1));
         std::vector<Photon> photons;
         uint64_t traced = 0;
-        if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel)) return false;
-        stats.photonsThinned += thinToBudget(pass, &photons);
+        if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel, &stats.photonsThinned)) return false;
         noteNarrowKernels(photons, r, stats);
         map_ = std::make_unique<PhotonMap>(std::move(photons), r);
         stats.photonsTraced += traced;
@@ -359,27 +358,41 @@ private:
     }
 
     /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
-    /// (index 0) and at stored events (index 1).
-    bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel) const {
+    /// (index 0) and at stored events (index 1). Batches run in groups, appended in batch order; with
+    /// `thinned`, whenever the photons kept pass twice the memory budget they are thinned to it
+    /// (thinToBudget: uniform, power rescaled, so repeated thinning stays unbiased). The pass's peak
+    /// memory is then about twice the budget plus one group's photons, not everything traced.
+    bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel,
+                      uint64_t* thinned = nullptr) const {
         if (!sourceDist_.size() || count <= 0) return true;
-        int batches = (count + PhotonBatch - 1) / PhotonBatch;
-        std::vector<std::vector<Photon>> perBatch(batches);
-        std::vector<std::array<double, 2>> perEnergy(batches, {0.0, 0.0});
-        std::atomic<bool> cancelled{false};
-        tbb::parallel_for(0, batches, [&](int b) {
-            if (cancelled || (cancel && cancel())) { cancelled = true; return; }
-            Rng rng(hashKeys(0x50484f54ULL, settings_.seed, pass, b, energy ? 1 : 0));
-            int n = std::min(PhotonBatch, count - b * PhotonBatch);
-            for (int i = 0; i < n; ++i) tracePhoton(rng, count, &perBatch[b], perEnergy[b].data());
-        });
-        if (cancelled) return false;
-        for (int b = 0; b < batches; ++b) {
-            photons->insert(photons->end(), perBatch[b].begin(), perBatch[b].end());
-            if (energy) { energy[0] += perEnergy[b][0]; energy[1] += perEnergy[b][1]; }
+        constexpr int GroupBatches = 16;
+        const size_t budget = maxPhotons();
+        int batches = (count + PhotonBatch - 1) / PhotonBatch, round = 0;
+        for (int g0 = 0; g0 < batches; g0 += GroupBatches) {
+            int g1 = std::min(batches, g0 + GroupBatches);
+            std::vector<std::vector<Photon>> perBatch(g1 - g0);
+            std::vector<std::array<double, 2>> perEnergy(g1 - g0, {0.0, 0.0});
+            std::atomic<bool> cancelled{false};
+            tbb::parallel_for(g0, g1, [&](int b) {
+                if (cancelled || (cancel && cancel())) { cancelled = true; return; }
+                Rng rng(hashKeys(0x50484f54ULL, settings_.seed, pass, b, energy ? 1 : 0));
+                int n = std::min(PhotonBatch, count - b * PhotonBatch);
+                for (int i = 0; i < n; ++i) tracePhoton(rng, count, &perBatch[b - g0], perEnergy[b - g0].data());
+            });
+            if (cancelled) return false;
+            for (int b = 0; b < g1 - g0; ++b) {
+                photons->insert(photons->end(), perBatch[b].begin(), perBatch[b].end());
+                if (energy) { energy[0] += perEnergy[b][0]; energy[1] += perEnergy[b][1]; }
+            }
+            if (thinned && photons->size() > 2 * budget) *thinned += thinToBudget(pass, round++, photons);
         }
+        if (thinned) *thinned += thinToBudget(pass, round, photons);
         *traced += count;
         return true;
     }
+
+    /// Photons that fit in settings.photonMapBudgetBytes (at least one).
+    size_t maxPhotons() const { return std::max<size_t>(1, settings_.photonMapBudgetBytes / PhotonMap::BytesPerPhoton); }
 
     /// An emissive medium as a photon source: uniform points in `box` where the medium is present,
     /// uniform directions. Volume emission is photon-traced so that its scattered light (which the
@@ -566,11 +579,11 @@ private:
     /// Keeps the photon map within the memory budget: exactly `budget` photons survive, chosen
     /// uniformly without replacement (a partial Fisher-Yates shuffle with a seeded stream), and
     /// their power is scaled by size / budget, so the estimate stays unbiased.
-    uint64_t thinToBudget(int pass, std::vector<Photon>* photons) const {
-        size_t maxPhotons = std::max<size_t>(1, settings_.photonMapBudgetBytes / PhotonMap::BytesPerPhoton);
+    uint64_t thinToBudget(int pass, int round, std::vector<Photon>* photons) const {
+        const size_t maxPhotons = this->maxPhotons();
         size_t n = photons->size();
         if (n <= maxPhotons) return 0;
-        Rng rng(hashKeys(0x5448494eULL, settings_.seed, pass));
+        Rng rng(hashKeys(0x5448494eULL, settings_.seed, pass, round));
         for (size_t i = 0; i < maxPhotons; ++i) {
             size_t j = i + std::min(n - i - 1, static_cast<size_t>(rng.uniform() * (n - i)));
             std::swap((*photons)[i], (*photons)[j]);
@@ -581,8 +594,7 @@ private:
         for (Photon& ph : *photons)
             for (float& c : ph.power) c = static_cast<float>(c * scale);
         uint64_t dropped = n - maxPhotons;
-        static std::atomic<bool> warned{false};
-        if (!warned.exchange(true))
+        if (!warnedBudget_.exchange(true))
             warn("photon map over its budget of " + std::to_string(settings_.photonMapBudgetBytes >> 20) + " MiB: " +
                  std::to_string(dropped) + " photons thinned (power rescaled; more noise, no bias)");
         return dropped;
@@ -628,6 +640,7 @@ private:
 
     double radius_, step_;
     bool warnedNarrow_ = false;
+    mutable std::atomic<bool> warnedBudget_{false};
     std::vector<int> pointLights_;
     Distribution1D extendedDist_;
     std::vector<Emitter> emitters_;

@@ -116,17 +116,20 @@ def cmd_reference(a) -> int:
     total = max(a.batches * 2, int(a.seconds / per_pass))
     total = max(a.min_passes, min(total, a.max_passes))
     total -= total % a.batches
-    # Restart so every batch has the same number of passes.
-    r = core.Renderer(scene, s)
+    # One renderer per batch, each with its own seed: the camera samples of one render are stratified
+    # over its passes (Rng::stratify), so consecutive batches of one render are not independent and
+    # their spread would misstate the reference's noise; separate seeds are independent randomisations.
     per_batch = total // a.batches
-    snaps = []
+    batches = []
     t0 = time.perf_counter()
     for b in range(a.batches):
+        s.seed = a.seed * 1000 + b
+        r = core.Renderer(scene, s)
         for _ in range(per_batch):
             r.render_pass()
-        snaps.append(np.array(r.film.beauty, dtype=np.float64))
+        batches.append(np.array(r.film.beauty, dtype=np.float64))
     seconds = time.perf_counter() - t0
-    batches = [snaps[0]] + [snaps[i] * (i + 1) - snaps[i - 1] * i for i in range(1, len(snaps))]
+    snaps = [np.mean(batches, axis=0)]
     np.savez_compressed(a.out, mean=snaps[-1].astype(np.float32), batches=np.array(batches, dtype=np.float32),
                         meta=json.dumps({"passes": total, "seconds": seconds, "build_seconds": build_s,
                                          "settings": s.to_dict(), "stats": _jsonable(r.stats),

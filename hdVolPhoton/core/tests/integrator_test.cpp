@@ -568,6 +568,21 @@ TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
     r.render();
     EXPECT_GT(r.stats().photonsThinned, 0u);
     EXPECT_LE(r.stats().photonMapBytes, capped.photonMapBudgetBytes);  // exactly within the budget
+
+    // Past one group of batches (16 x 4096 photons) the photons are thinned as they are traced, in
+    // several rounds; still no bias.
+    RenderSettings many = full;
+    many.samplesPerPixel = 2;
+    many.photonsPerPass = 150000;
+    RenderSettings manyCapped = many;
+    manyCapped.photonMapBudgetBytes = 3000 * PhotonMap::BytesPerPhoton;
+    auto c = imageMean(d, many, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    auto e = imageMean(d, manyCapped, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    EXPECT_NEAR(c.mean, e.mean, 4 * std::hypot(c.stderr_, e.stderr_));
+    Renderer rm(std::make_shared<Scene>(d), manyCapped);
+    rm.render();
+    EXPECT_GT(rm.stats().photonsThinned, 0u);
+    EXPECT_LE(rm.stats().photonMapBytes, manyCapped.photonMapBudgetBytes);
 }
 
 TEST(IntegratorAgreement, ScatteringEmissiveMedium) {
