@@ -809,6 +809,7 @@ def test_frames_render_each_time_code(tmp_path):
     assert len(fr["passes"]) == 2 and all(p["seconds"] >= 0 for p in fr["passes"])
     assert fr["render"]["camera_samples"] == 8 * 8 * 2
     assert any("no media" in s for s in fr["render"]["passes_skipped"])
+    assert fr["render"]["photons_thinned"] == 0 and fr["render"]["photons_radius_capped"] == 0
     assert fr["timings"]["wall_seconds"] > 0 and fr["scene"]["lights"] == 1
     # several frames without a placeholder: usage error
     r = run_cli("render", path, "-o", tmp_path / "out.exr", "--frames", "1:2")

@@ -567,6 +567,8 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "photon_radius": rstats["photon_radius"],
             "multiple_to_single_ratio": rstats["multiple_to_single_ratio"],
             "photon_map_bytes": rstats["photon_map_bytes"],
+            "photons_thinned": rstats["photons_thinned"],
+            "photons_radius_capped": rstats["photons_radius_capped"],
             "passes_run": rstats["passes_run"],
             "passes_skipped": rstats["passes_skipped"],
         },
