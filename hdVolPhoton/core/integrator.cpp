@@ -31,7 +31,7 @@ DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng) const {
     DirectSample d;
     if (!lightDist_.size()) return d;
     size_t i = lightDist_.sampleDiscrete(rng.uniform(), &d.pickProb);
-    double u1 = rng.uniform(), u2 = rng.uniform();
+    auto [u1, u2] = rng.uniform2();
     d.light = static_cast<int>(i);
     d.ls = scene_.lights()[i]->sample(p, u1, u2);
     return d;
@@ -125,7 +125,8 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
         case SurfaceMaterial::Kind::Lambertian: {
             if (m.albedo.isBlack()) return s;
             Vec3 n = dot(wo, hit.ns) >= 0 ? hit.ns : -hit.ns;
-            Vec3 w = Frame::fromZ(n).toWorld(cosineHemisphere(rng.uniform(), rng.uniform()));
+            auto [c1, c2] = rng.uniform2();
+            Vec3 w = Frame::fromZ(n).toWorld(cosineHemisphere(c1, c2));
             if (dot(w, hit.ng) * dot(wo, hit.ng) <= 0) return s;  // shading normal sent it below the surface
             s.type = SurfaceScatter::Type::Diffuse;
             s.next = {hit.p, w};

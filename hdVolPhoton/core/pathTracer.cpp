@@ -143,7 +143,9 @@ public:
                     }
                 }
                 // Phase sampling.
-                Vec3 w = mp.sampleScatter(ray.d, rng.uniform(), rng.uniform(), rng.uniform());
+                double uLobe = rng.uniform();
+                auto [s1, s2] = rng.uniform2();
+                Vec3 w = mp.sampleScatter(ray.d, uLobe, s1, s2);
                 double cosTheta = dot(ray.d, w);
                 double pdf = mp.scatterPdf(cosTheta);
                 if (!(pdf > 0)) break;
@@ -246,7 +248,8 @@ private:
                                    const Spectrum& beta, Rng& rng) const {
         double pick;
         size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
-        double u = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        double u = rng.uniform();
+        auto [u1, u2] = rng.uniform2();
         if (!isPointLight(static_cast<int>(li)) || !(s.b > s.a)) return {};
         Vec3 lp = pointLightPosition_[li];
         double delta = dot(lp - ray.o, ray.d), D = length(lp - ray.at(delta));

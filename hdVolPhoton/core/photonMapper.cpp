@@ -293,7 +293,7 @@ private:
     Spectrum directExtended(const Vec3& p, const Vec3& d, const MediumProperties& mp, const MediumStack& stack, Rng& rng) const {
         double pick;
         size_t li = extendedDist_.sampleDiscrete(rng.uniform(), &pick);
-        double u1 = rng.uniform(), u2 = rng.uniform();
+        auto [u1, u2] = rng.uniform2();
         LightSample ls = scene_.lights()[li]->sample(p, u1, u2);
         if (!(ls.pdf > 0) || ls.Li.isBlack()) return {};
         Spectrum f = mp.scatterKernel(dot(d, ls.wi));
@@ -323,7 +323,8 @@ private:
         Vec3 p = ray.at(t);
         MediumProperties mp = media.properties(p);
         if (mp.sigma_s.isBlack()) return {};
-        LightSample ls = L.sample(p, rng.uniform(), rng.uniform());
+        auto [l1, l2] = rng.uniform2();
+        LightSample ls = L.sample(p, l1, l2);
         if (!(ls.pdf > 0) || ls.Li.isBlack()) return {};
         Spectrum f = mp.scatterKernel(dot(ray.d, ls.wi));
         Spectrum T = shadowTransmittance(p, ls.wi, ls.dist, stack, rng);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 namespace volphoton {
 
@@ -116,6 +117,15 @@ public:
         if (qmcDim_ < qmcDims_) return stratified();
         uint64_t hi = nextU32() >> 5, lo = nextU32() >> 6;  // 27 + 26 bits
         return static_cast<double>((hi << 26) | lo) * (1.0 / 9007199254740992.0);
+    }
+
+    /// Two draws for one 2D sample. In the stratified prefix both come from one Sobol' pair (a draw
+    /// is skipped when the current pair is half used), so the 2D sample is stratified as a whole.
+    std::pair<double, double> uniform2() {
+        if (qmcDim_ < qmcDims_ && (qmcDim_ & 1)) ++qmcDim_;
+        double a = uniform();
+        double b = uniform();
+        return {a, b};
     }
 
     /// Makes the next `dims` draws sample `sampleIndex` of a padded, shuffled, Owen-scrambled 2D
