@@ -209,6 +209,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                             L = PathRadiance();
                         }
                         film_.add(x, y, L);
+                        if (pass_ == 0) film_.setIds(x, y, pixelIds(camera, x, y));
                     }
             }
     });
@@ -224,6 +225,27 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     ++pass_;
     ++stats_.passes;
     return true;
+}
+
+PixelIds Renderer::pixelIds(const Camera& camera, int x, int y) const {
+    double tMin, tMax;
+    Ray ray = camera.generateRay(x + 0.5, y + 0.5, 0.0, 0.0, &tMin, &tMax);
+    PixelIds boundary;
+    for (int crossings = 0; crossings < 64; ++crossings) {
+        SurfaceHit hit;
+        if (!scene_->intersect(ray, tMin, tMax, &hit)) break;
+        const MeshDesc& mesh = scene_->mesh(hit.mesh);
+        const InstanceDesc& inst = scene_->desc().instances[hit.instance];
+        PixelIds ids{inst.objectId, inst.instanceId,
+                     mesh.triangleElements.empty() ? hit.triangle : mesh.triangleElements[hit.triangle]};
+        if (mesh.material.kind != SurfaceMaterial::Kind::Boundary) return ids;
+        if (boundary.object < 0) boundary = ids;
+        // Straight on through the boundary, as PathRay::passBoundary does.
+        ray = {hit.p, ray.d};
+        if (!std::isinf(tMax)) tMax -= hit.t;
+        tMin = scene_->epsilon() / std::max(std::abs(dot(ray.d, hit.ng)), 0.1);
+    }
+    return boundary;
 }
 
 RenderStats Renderer::render(const ProgressCallback& progress, const CancelCallback& cancel) {

@@ -97,7 +97,8 @@ class Integrator;
 /// \class Renderer
 /// Progressive rendering of a Scene into a Film: each pass adds one sample per pixel (after a photon
 /// pass for the photon-map integrator). Tiles run in parallel with TBB; the cancel callback is polled
-/// per tile and per photon batch. Same settings -> bit-identical film.
+/// per tile and per photon batch. Same settings -> bit-identical film. Pass 0 also fills the film's id
+/// images from each pixel's centre ray (pixelIds()).
 class Renderer {
 public:
     Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings);
@@ -109,6 +110,12 @@ public:
     const Film& film() const { return film_; }
     const RenderStats& stats() const { return stats_; }
     const RenderSettings& settings() const { return settings_; }
+
+    /// Ids of what the centre ray of pixel (x, y) meets first: the first surface that is not an
+    /// index-matched medium boundary; where there is none, the first medium boundary it crossed (so a
+    /// fog box is reported where it is seen against the background). Media bounded by their own
+    /// bounds (Hydra volumes, atmospheres) report nothing.
+    PixelIds pixelIds(const Camera& camera, int x, int y) const;
 
 private:
     std::shared_ptr<const Scene> scene_;

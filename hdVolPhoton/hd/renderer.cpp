@@ -98,9 +98,14 @@ void HdVolPhoton_Renderer::_WriteAovs(Film const &film) {
                     depth[i] = static_cast<float>(std::clamp(0.5 * (clipZ / clipW) + 0.5, 0.0, 1.0));
                 }
             buffer->WriteFloats(depth, 1);
-        } else if (name == HdAovTokens->primId || name == HdAovTokens->instanceId || name == HdAovTokens->elementId) {
-            // XXX: the core does not report which prim a pixel saw yet; -1 is "nothing".
-            buffer->WriteInts(std::vector<int>(static_cast<size_t>(film.width()) * film.height(), -1));
+        } else if (name == HdAovTokens->primId) {
+            // What the pixel-centre ray met first (Renderer::pixelIds): the rprim's prim id, its
+            // instance index and authored face, as hdEmbree reports them; -1 where it met nothing.
+            buffer->WriteInts(film.resolveIds(Film::ObjectId));
+        } else if (name == HdAovTokens->instanceId) {
+            buffer->WriteInts(film.resolveIds(Film::InstanceId));
+        } else if (name == HdAovTokens->elementId) {
+            buffer->WriteInts(film.resolveIds(Film::ElementId));
         } else {
             static const std::pair<char const *, Film::Aov> split[] = {
                 {"single", Film::Single}, {"multiple", Film::Multiple}, {"emission", Film::Emission}, {"surface", Film::Surface}};

@@ -630,3 +630,48 @@ TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
         EXPECT_GT(lit, 0.0);
     }
 }
+
+TEST(IntegratorIds, PixelCentreRayReportsTheFirstVisibleSurface) {
+    // Two quads at z = 0 (lower left: object 7, elements given; lower right: object 9, instance 2)
+    // behind an index-matched boundary quad at z = 1 (object 5) that covers the middle of the image.
+    // Pixels see through the boundary to a quad where there is one, the boundary where there is
+    // none, and -1 outside both. The ids do not depend on the seed (pixel-centre ray, pass 0).
+    auto quad = [](double x0, double x1, double y0, double y1, double z) {
+        MeshDesc m;
+        m.points = {Vec3(x0, y0, z), Vec3(x1, y0, z), Vec3(x1, y1, z), Vec3(x0, y1, z)};
+        m.indices = {0, 1, 2, 0, 2, 3};
+        return m;
+    };
+    SceneDesc d;
+    d.meshes.push_back(quad(-1.5, -0.1, -1.5, 0.0, 0.0));
+    d.meshes[0].triangleElements = {4, 4};
+    d.meshes.push_back(quad(0.1, 1.5, -1.5, 0.0, 0.0));
+    d.meshes.push_back(quad(-1.5, 1.5, -1.0, 1.0, 1.0));
+    d.meshes[2].material.kind = SurfaceMaterial::Kind::Boundary;
+    d.instances = {{0, Affine(), 7, 0}, {1, Affine(), 9, 2}, {2, Affine(), 5, 0}};
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0));
+    auto scene = std::make_shared<Scene>(d);
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap})
+        for (uint64_t seed : {1u, 2u}) {
+            RenderSettings s = smallSettings(integrator, 2, seed);
+            s.width = s.height = 16;
+            Renderer r(scene, s);
+            r.render();
+            const Film& f = r.film();
+            auto at = [&](int x, int y) { return f.ids(x, y); };
+            EXPECT_EQ(at(3, 12).object, 7);
+            EXPECT_EQ(at(3, 12).instance, 0);
+            EXPECT_EQ(at(3, 12).element, 4);
+            EXPECT_EQ(at(12, 12).object, 9);
+            EXPECT_EQ(at(12, 12).instance, 2);
+            EXPECT_TRUE(at(12, 12).element == 0 || at(12, 12).element == 1);
+            EXPECT_EQ(at(8, 3).object, 5);
+            EXPECT_EQ(at(0, 0).object, -1);
+            EXPECT_EQ(at(0, 0).instance, -1);
+            EXPECT_EQ(at(0, 0).element, -1);
+            std::vector<int> objects = f.resolveIds(Film::ObjectId);
+            EXPECT_EQ(objects[12 * 16 + 3], 7);
+            EXPECT_EQ(f.resolveIds(Film::InstanceId)[12 * 16 + 12], 2);
+        }
+}
