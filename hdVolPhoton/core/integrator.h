@@ -105,6 +105,12 @@ public:
     ~Renderer();
     /// Runs one more pass; returns false if cancelled.
     bool renderPass(const CancelCallback& cancel = {});
+    /// A coarse preview for interactive front ends (the first frame after a restart): one path-traced
+    /// sample from the centre pixel of every block x block pixel block, written to every pixel of the
+    /// block in `preview` (cleared first; the film's size), ids included. The renderer's own film,
+    /// pass count and stats are untouched, so the progressive result is bit-identical with or without
+    /// previews. Path traced whatever the integrator: no photon pass to wait for. False if cancelled.
+    bool renderPreview(int block, Film& preview, const CancelCallback& cancel = {}) const;
     /// Runs all samplesPerPixel passes.
     RenderStats render(const ProgressCallback& progress = {}, const CancelCallback& cancel = {});
     const Film& film() const { return film_; }

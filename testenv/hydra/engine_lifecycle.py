@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): pause, resume,
-stop, convergence and restart on a camera change. Run by test_hydra_lifecycle.py with OpenUSD's
-Python (the interpreter of usdrecord) and the delegate on PXR_PLUGINPATH_NAME:
+stop, convergence, restart on a camera change, and when the coarse preview is shown. Run by
+test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
+PXR_PLUGINPATH_NAME:
 
     python3 engine_lifecycle.py SCENE.usda CAMERA_PATH
 
@@ -63,11 +64,15 @@ def main(scene, camera_path):
 
     # Converges at convergedSamplesPerPixel and stays there. (Set after the first Render(): the
     # scene's RenderSettings prim, synced then, sets it too.)
-    stats()
+    # The first render has no pass time to go by: a 4x4-block preview comes before the first pass.
+    render_until(lambda: stats()["framesWritten"] >= 2)
+    check(stats()["previewBlock"] == 4, "the first render starts with a 4x4 preview: %s" % stats()["previewBlock"])
     engine.SetRendererSetting("convergedSamplesPerPixel", 4)
     render_until(lambda: passes() > 0 and engine.IsConverged())
     s = stats()
     check(s["passes"] == 4 and s["percentDone"] == 100.0, "converged after exactly 4 passes: %s" % s["passes"])
+    # Passes at 64x36 take milliseconds: a restart then shows no preview, only the 4 passes.
+    check(s["previewBlock"] == 0 and s["framesWritten"] == 4, "no preview after fast passes: %s" % s)
     a, b = quiet_for(0.2)
     check(a == b == 4 and engine.IsConverged(), "a converged render stays converged")
 

@@ -675,3 +675,37 @@ TEST(IntegratorIds, PixelCentreRayReportsTheFirstVisibleSurface) {
             EXPECT_EQ(f.resolveIds(Film::InstanceId)[12 * 16 + 12], 2);
         }
 }
+
+TEST(IntegratorPreview, CoarsePreviewFillsBlocksAndLeavesTheRenderUnchanged) {
+    // A preview between passes must not change the progressive film (bit-identical), and fills
+    // every pixel of each block with its one sample.
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}),
+                                   Vec3(0.2, 0.1, 3));
+        auto scene = std::make_shared<Scene>(d);
+        RenderSettings s = smallSettings(integrator, 3, 5);
+        s.width = 18;
+        s.height = 11;  // not a multiple of the block: partial blocks at the edges
+        Renderer plain(scene, s), previewed(scene, s);
+        plain.render();
+        Film preview(s.width, s.height);
+        ASSERT_TRUE(previewed.renderPreview(4, preview));
+        for (int pass = 0; pass < s.samplesPerPixel; ++pass) {
+            ASSERT_TRUE(previewed.renderPass());
+            ASSERT_TRUE(previewed.renderPreview(4, preview));
+        }
+        EXPECT_EQ(plain.film().resolveRgb(Film::Beauty), previewed.film().resolveRgb(Film::Beauty));
+        EXPECT_EQ(plain.film().resolveIds(Film::ObjectId), previewed.film().resolveIds(Film::ObjectId));
+        EXPECT_EQ(plain.stats().passes, previewed.stats().passes);
+        auto rgb = preview.resolveRgb(Film::Beauty);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                EXPECT_EQ(preview.samples(x, y), 1u);
+                size_t i = 3 * (static_cast<size_t>(y) * s.width + x), b = 3 * (static_cast<size_t>(y / 4 * 4) * s.width + x / 4 * 4);
+                EXPECT_EQ(rgb[i], rgb[b]) << x << "," << y;
+            }
+        Film wrongSize(4, 4);
+        EXPECT_THROW(previewed.renderPreview(4, wrongSize), std::invalid_argument);
+    }
+}
