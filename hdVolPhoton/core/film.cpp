@@ -16,6 +16,7 @@ void Film::clear() {
     alpha_.assign(n, 0.0);
     depth_.assign(n, std::numeric_limits<float>::infinity());
     count_.assign(n, 0);
+    ids_.assign(n, PixelIds());
 }
 
 void Film::add(int x, int y, const PathRadiance& r) {
@@ -35,6 +36,7 @@ void Film::merge(const Film& o) {
         alpha_[i] += o.alpha_[i];
         depth_[i] = std::min(depth_[i], o.depth_[i]);
         count_[i] += o.count_[i];
+        if (ids_[i].object < 0) ids_[i] = o.ids_[i];
     }
 }
 
@@ -52,5 +54,12 @@ std::vector<float> Film::resolveAlpha() const {
 }
 
 std::vector<float> Film::resolveDepth() const { return depth_; }
+
+std::vector<int> Film::resolveIds(IdAov which) const {
+    std::vector<int> out(ids_.size());
+    for (size_t i = 0; i < ids_.size(); ++i)
+        out[i] = which == ObjectId ? ids_[i].object : which == InstanceId ? ids_[i].instance : ids_[i].element;
+    return out;
+}
 
 }  // namespace volphoton

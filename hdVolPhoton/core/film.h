@@ -18,14 +18,26 @@ struct PathRadiance {
     Spectrum beauty() const { return single + multiple + emission + surface; }
 };
 
+/// What a pixel's camera ray met first: the front end's opaque ids of the instance
+/// (InstanceDesc::objectId, instanceId) and the element (MeshDesc::triangleElements). -1: nothing.
+struct PixelIds {
+    int object = -1, instance = -1, element = -1;
+};
+
 /// \class Film
 /// Sums of samples per pixel and 32-bit sample counts; resolve() divides. Rows are top to bottom.
-/// Each pixel is written by one thread at a time (tiles do not overlap).
+/// Each pixel is written by one thread at a time (tiles do not overlap). The id images hold one
+/// PixelIds per pixel, written once per render from the pixel-centre ray (Renderer), not averaged.
 class Film {
 public:
     enum Aov { Beauty, Single, Multiple, Emission, Surface, RgbAovCount };
+    enum IdAov { ObjectId, InstanceId, ElementId };
     Film(int width, int height);
     void add(int x, int y, const PathRadiance& r);
+    void setIds(int x, int y, const PixelIds& ids) { ids_[index(x, y)] = ids; }
+    PixelIds ids(int x, int y) const { return ids_[index(x, y)]; }
+    /// One id image, rows top to bottom; -1 where nothing was met.
+    std::vector<int> resolveIds(IdAov which) const;
     /// Mean per pixel: RGB AOVs, alpha, depth (minimum over samples, +inf where nothing was hit).
     std::vector<float> resolveRgb(Aov aov) const;
     std::vector<float> resolveAlpha() const;
@@ -34,7 +46,7 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
     void clear();
-    /// Adds every pixel of other (same size) into this film.
+    /// Adds every pixel of other (same size) into this film; ids come from other where this has none.
     void merge(const Film& other);
 
 private:
@@ -44,6 +56,7 @@ private:
     std::vector<double> alpha_;
     std::vector<float> depth_;
     std::vector<uint32_t> count_;
+    std::vector<PixelIds> ids_;
 };
 
 }  // namespace volphoton

@@ -213,6 +213,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                             L = PathRadiance();
                         }
                         film_.add(x, y, L);
+                        if (pass_ == 0) film_.setIds(x, y, pixelIds(camera, x, y));
                     }
             }
     });
@@ -228,6 +229,66 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     ++pass_;
     ++stats_.passes;
     return true;
+}
+
+bool Renderer::renderPreview(int block, Film& preview, const CancelCallback& cancel) const {
+    if (block < 1 || preview.width() != settings_.width || preview.height() != settings_.height)
+        throw std::invalid_argument("preview: block must be >= 1 and the film the render's size");
+    std::unique_ptr<tbb::global_control> threads;
+    if (settings_.threads > 0)
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings_.threads);
+    preview.clear();
+    std::unique_ptr<Integrator> pathTracer = makePathTracer(*scene_, settings_);
+    Camera camera(scene_->desc().camera, settings_.width, settings_.height);
+    int blocksX = (settings_.width + block - 1) / block, blocksY = (settings_.height + block - 1) / block;
+    std::atomic<bool> cancelled{false};
+    // A stream no pass uses (passes count up from 0), so the preview shares no samples with them.
+    const uint64_t previewStream = ~uint64_t(0);
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, blocksY, 0, blocksX), [&](const tbb::blocked_range2d<int>& r) {
+        if (cancelled.load(std::memory_order_relaxed) || (cancel && cancel())) {
+            cancelled = true;
+            return;
+        }
+        for (int by = r.rows().begin(); by < r.rows().end(); ++by)
+            for (int bx = r.cols().begin(); bx < r.cols().end(); ++bx) {
+                int x0 = bx * block, y0 = by * block;
+                int x1 = std::min(settings_.width, x0 + block), y1 = std::min(settings_.height, y0 + block);
+                int cx = (x0 + x1 - 1) / 2, cy = (y0 + y1 - 1) / 2;
+                Rng rng(hashKeys(cx, cy, settings_.seed), previewStream);
+                double tMin, tMax;
+                Ray ray = camera.generateRay(cx + rng.uniform(), cy + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
+                PathRadiance L = pathTracer->Li(ray, tMin, tMax, rng);
+                if (!L.beauty().isFinite() || L.beauty().minValue() < 0) L = PathRadiance();
+                PixelIds ids = pixelIds(camera, cx, cy);
+                for (int y = y0; y < y1; ++y)
+                    for (int x = x0; x < x1; ++x) {
+                        preview.add(x, y, L);
+                        preview.setIds(x, y, ids);
+                    }
+            }
+    });
+    return !cancelled;
+}
+
+PixelIds Renderer::pixelIds(const Camera& camera, int x, int y) const {
+    double tMin, tMax;
+    Ray ray = camera.generateRay(x + 0.5, y + 0.5, 0.0, 0.0, &tMin, &tMax);
+    PixelIds boundary;
+    for (int crossings = 0; crossings < 64; ++crossings) {
+        SurfaceHit hit;
+        if (!scene_->intersect(ray, tMin, tMax, &hit)) break;
+        const MeshDesc& mesh = scene_->mesh(hit.mesh);
+        const InstanceDesc& inst = scene_->desc().instances[hit.instance];
+        PixelIds ids{inst.objectId, inst.instanceId,
+                     mesh.triangleElements.empty() ? hit.triangle : mesh.triangleElements[hit.triangle]};
+        if (mesh.material.kind != SurfaceMaterial::Kind::Boundary) return ids;
+        if (boundary.object < 0) boundary = ids;
+        // Straight on through the boundary, as PathRay::passBoundary does.
+        ray = {hit.p, ray.d};
+        if (!std::isinf(tMax)) tMax -= hit.t;
+        tMin = scene_->epsilon() / std::max(std::abs(dot(ray.d, hit.ng)), 0.1);
+    }
+    return boundary;
 }
 
 RenderStats Renderer::render(const ProgressCallback& progress, const CancelCallback& cancel) {

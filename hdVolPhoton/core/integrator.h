@@ -107,18 +107,31 @@ class Integrator;
 /// \class Renderer
 /// Progressive rendering of a Scene into a Film: each pass adds one sample per pixel (after a photon
 /// pass for the photon-map integrator). Tiles run in parallel with TBB; the cancel callback is polled
-/// per tile and per photon batch. Same settings -> bit-identical film.
+/// per tile and per photon batch. Same settings -> bit-identical film. Pass 0 also fills the film's id
+/// images from each pixel's centre ray (pixelIds()).
 class Renderer {
 public:
     Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings);
     ~Renderer();
     /// Runs one more pass; returns false if cancelled.
     bool renderPass(const CancelCallback& cancel = {});
+    /// A coarse preview for interactive front ends (the first frame after a restart): one path-traced
+    /// sample from the centre pixel of every block x block pixel block, written to every pixel of the
+    /// block in `preview` (cleared first; the film's size), ids included. The renderer's own film,
+    /// pass count and stats are untouched, so the progressive result is bit-identical with or without
+    /// previews. Path traced whatever the integrator: no photon pass to wait for. False if cancelled.
+    bool renderPreview(int block, Film& preview, const CancelCallback& cancel = {}) const;
     /// Runs all samplesPerPixel passes.
     RenderStats render(const ProgressCallback& progress = {}, const CancelCallback& cancel = {});
     const Film& film() const { return film_; }
     const RenderStats& stats() const { return stats_; }
     const RenderSettings& settings() const { return settings_; }
+
+    /// Ids of what the centre ray of pixel (x, y) meets first: the first surface that is not an
+    /// index-matched medium boundary; where there is none, the first medium boundary it crossed (so a
+    /// fog box is reported where it is seen against the background). Media bounded by their own
+    /// bounds (Hydra volumes, atmospheres) report nothing.
+    PixelIds pixelIds(const Camera& camera, int x, int y) const;
 
 private:
     std::shared_ptr<const Scene> scene_;

@@ -48,6 +48,8 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     for (size_t mi = 0; mi < desc_.meshes.size(); ++mi) {
         MeshDesc& m = desc_.meshes[mi];
         if (m.indices.size() % 3) throw std::invalid_argument("mesh '" + m.name + "': index count is not a multiple of 3");
+        if (!m.triangleElements.empty() && m.triangleElements.size() != m.indices.size() / 3)
+            throw std::invalid_argument("mesh '" + m.name + "': triangleElements must be empty or one per triangle");
         for (uint32_t i : m.indices)
             if (i >= m.points.size()) throw std::invalid_argument("mesh '" + m.name + "': index out of range");
         for (const Vec3& p : m.points)
@@ -171,6 +173,7 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
     hit->p = ray.at(hit->t);
     hit->mesh = id.mesh;
     hit->instance = inst;
+    hit->triangle = static_cast<int>(rh.hit.primID);
     uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1], i2 = m.indices[3 * rh.hit.primID + 2];
     Vec3 nObj = cross(m.points[i1] - m.points[i0], m.points[i2] - m.points[i0]);
     Vec3 ng = Affine::normal(instanceInverse_[inst], nObj);

@@ -40,11 +40,18 @@ struct MeshDesc {
     std::vector<Vec3> normals;      ///< optional, per vertex
     SurfaceMaterial material;
     int interiorMedium = -1;  ///< index into SceneDesc::media, or -1
+    /// Optional, one per triangle: the front end's element (authored face) index of the triangle,
+    /// reported by the element-id image. Empty: the triangle index.
+    std::vector<int> triangleElements;
 };
 
 struct InstanceDesc {
     int mesh = 0;
     Affine transform;
+    /// Opaque identities the front end gives this instance, reported per pixel by the id images of
+    /// the Film (the Hydra delegate: the rprim's prim id and the instance index). -1: none.
+    int objectId = -1;
+    int instanceId = -1;
 };
 
 struct SceneDesc {
@@ -63,6 +70,7 @@ struct SurfaceHit {
     Vec3 ns;  ///< shading normal, unit, same side as ng
     int mesh = -1;
     int instance = -1;
+    int triangle = -1;  ///< index of the triangle within the mesh
 };
 
 /// The closed dielectric and boundary meshes the path is inside, innermost last. Crossing one toggles

@@ -79,9 +79,11 @@ std::optional<HdVolPhoton_MediumParams> HdVolPhoton_ReadMediumParams(HdSceneDele
     _Get(sd, id, "volphoton:exponential:b", &p.expB);
     p.expB = _Clamp(id, "volphoton:exponential:b", p.expB, 0.0f, 1e30f, 1.0f);
     GfVec3f up;
-    if (_Get(sd, id, "volphoton:exponential:up", &up)) {
+    // The attribute has no fallback. The scene-index path of OpenUSD 24.08 reports it unauthored as
+    // (0, 0, 0), so a zero vector means "unauthored" (+Y) without a warning on either path.
+    if (_Get(sd, id, "volphoton:exponential:up", &up) && up != GfVec3f(0.0f)) {
         if (up.GetLength() > 0 && std::isfinite(up.GetLength())) p.expUp = up;
-        else TF_WARN("%s.volphoton:exponential:up: a zero or non-finite vector; using +Y", id.GetText());
+        else TF_WARN("%s.volphoton:exponential:up: a non-finite vector; using +Y", id.GetText());
     }
     _Get(sd, id, "volphoton:exponential:origin", &p.expOrigin);
     if (_Get(sd, id, "volphoton:ior", &p.ior)) p.ior = _Clamp(id, "volphoton:ior", p.ior, 1.0f, 10.0f, 1.0f);

@@ -36,6 +36,7 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
     SdfPath const &id = GetId();
     HdVolPhoton_MeshRecord rec;
     rec.mesh.name = id.GetString();
+    rec.primId = GetPrimId();
 
     VtValue pointsValue = sceneDelegate->Get(id, HdTokens->points);
     VtVec3fArray points = pointsValue.IsHolding<VtVec3fArray>() ? pointsValue.UncheckedGet<VtVec3fArray>() : VtVec3fArray();
@@ -50,7 +51,7 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
     std::map<int, size_t> faceSubset;
     for (HdGeomSubset const &subset : topology.GetGeomSubsets()) {
         if (subset.type != HdGeomSubset::TypeFaceSet || subset.materialId.IsEmpty()) continue;
-        rec.subsets.push_back({subset.materialId, {}});
+        rec.subsets.push_back({subset.materialId, {}, {}});
         for (int face : subset.indices) faceSubset[face] = rec.subsets.size() - 1;
     }
     size_t dropped = 0;
@@ -59,21 +60,26 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
         bool valid = true;
         for (int k = 0; k < 3; ++k) valid &= t[k] >= 0 && static_cast<size_t>(t[k]) < points.size();
         if (!valid) { ++dropped; continue; }
+        int face = i < primitiveParams.size() ? HdMeshUtil::DecodeFaceIndexFromCoarseFaceParam(primitiveParams[i])
+                                              : static_cast<int>(i);
         if (!faceSubset.empty()) {
-            auto it = faceSubset.find(HdMeshUtil::DecodeFaceIndexFromCoarseFaceParam(primitiveParams[i]));
+            auto it = faceSubset.find(face);
             if (it != faceSubset.end()) {
-                rec.subsets[it->second].second.insert(rec.subsets[it->second].second.end(),
-                                                      {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+                HdVolPhoton_SubsetRecord &sub = rec.subsets[it->second];
+                sub.indices.insert(sub.indices.end(), {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+                sub.faces.push_back(face);
                 continue;
             }
         }
         rec.mesh.indices.insert(rec.mesh.indices.end(), {uint32_t(t[0]), uint32_t(t[1]), uint32_t(t[2])});
+        rec.mesh.triangleElements.push_back(face);
     }
     if (dropped) TF_WARN("%s: %zu triangles index points out of range; dropped", id.GetText(), dropped);
     for (volphoton::Vec3 const &p : rec.mesh.points)
         if (!volphoton::isFinite(p)) {
             TF_WARN("%s.points: non-finite point; mesh skipped", id.GetText());
             rec.mesh.indices.clear();
+            rec.mesh.triangleElements.clear();
             break;
         }
 
@@ -91,13 +97,14 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
         rec.medium = *medium;
     }
 
+    // The instancer id is only known after _UpdateInstancer (a prototype's first Sync included).
+    _UpdateInstancer(sceneDelegate, dirtyBits);
     if (sceneDelegate->GetVisible(id)) {
         GfMatrix4d objectToWorld = sceneDelegate->GetTransform(id);
         SdfPath const &instancerId = GetInstancerId();
         if (instancerId.IsEmpty()) {
             rec.instances.push_back(HdVolPhoton_ToAffine(objectToWorld));
         } else {
-            _UpdateInstancer(sceneDelegate, dirtyBits);
             HdInstancer::_SyncInstancerAndParents(sceneDelegate->GetRenderIndex(), instancerId);
             auto *instancer = static_cast<HdVolPhotonInstancer *>(sceneDelegate->GetRenderIndex().GetInstancer(instancerId));
             if (instancer)

@@ -1,13 +1,16 @@
 #include "hd/renderer.h"
 
 #include "pxr/base/tf/diagnostic.h"
+#include "pxr/base/tf/getenv.h"
 #include "pxr/base/vt/array.h"
 #include "pxr/base/vt/types.h"
 #include "pxr/imaging/hd/tokens.h"
 
 #include "hd/renderBuffer.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -23,6 +26,8 @@ void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSe
     std::lock_guard<std::mutex> lock(_statsMutex);
     _stats = RenderStats();
     _converged = false;
+    _framesWritten = _previewBlock = 0;
+    _previewEnabled = TfGetenvBool("HDVOLPHOTON_PREVIEW", true);  // debug knob, read per restart
 }
 
 bool HdVolPhoton_Renderer::IsConverged() const {
@@ -44,6 +49,8 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["cameraSeconds"] = VtValue(_stats.cameraSeconds);
     d["passesRun"] = VtValue(VtStringArray(_stats.passesRun.begin(), _stats.passesRun.end()));
     d["passesSkipped"] = VtValue(VtStringArray(_stats.passesSkipped.begin(), _stats.passesSkipped.end()));
+    d["framesWritten"] = VtValue(_framesWritten);
+    d["previewBlock"] = VtValue(_previewBlock);
     d["percentDone"] = VtValue(_settings.samplesPerPixel > 0 ? 100.0 * _stats.passes / _settings.samplesPerPixel : 100.0);
     return d;
 }
@@ -58,18 +65,49 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
         return;
     }
     auto cancel = [thread]() { return thread->IsStopRequested(); };
-    for (int pass = 0; pass < _settings.samplesPerPixel; ++pass) {
+    auto waitWhilePaused = [thread]() {
         while (thread->IsPauseRequested() && !thread->IsStopRequested())
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    };
+    if (int block = _PreviewBlock(); block > 1) {
+        waitWhilePaused();
+        Film preview(_settings.width, _settings.height);
+        if (!renderer->renderPreview(block, preview, cancel)) return;
+        {
+            std::lock_guard<std::mutex> lock(_statsMutex);
+            _previewBlock = block;
+            ++_framesWritten;
+        }
+        auto fb = thread->LockFramebuffer();
+        _WriteAovs(preview);
+    }
+    for (int pass = 0; pass < _settings.samplesPerPixel; ++pass) {
+        waitWhilePaused();
+        double before = renderer->stats().seconds;
         if (!renderer->renderPass(cancel)) break;
+        _lastPassSeconds = renderer->stats().seconds - before;
         {
             std::lock_guard<std::mutex> lock(_statsMutex);
             _stats = renderer->stats();
             _converged = pass + 1 == _settings.samplesPerPixel;
+            ++_framesWritten;
         }
         auto fb = thread->LockFramebuffer();
         _WriteAovs(renderer->film());
     }
+}
+
+int HdVolPhoton_Renderer::_PreviewBlock() const {
+    // Unknown cost (the first render): a 4 x 4 block. Otherwise about PreviewTargetSeconds, as the
+    // preview costs a pass / block^2; a fast pass needs no preview (it would only flash blocks).
+    if (!_previewEnabled) return 1;
+    int block = 4;
+    if (_lastPassSeconds >= 0) {
+        if (_lastPassSeconds < PreviewAfterSeconds) return 1;
+        block = std::clamp(static_cast<int>(std::ceil(std::sqrt(_lastPassSeconds / PreviewTargetSeconds))), 2, 8);
+    }
+    // Too small an image for blocks to help.
+    return std::min(_settings.width, _settings.height) >= 4 * block ? block : 1;
 }
 
 void HdVolPhoton_Renderer::_WriteAovs(Film const &film) {
@@ -98,9 +136,14 @@ void HdVolPhoton_Renderer::_WriteAovs(Film const &film) {
                     depth[i] = static_cast<float>(std::clamp(0.5 * (clipZ / clipW) + 0.5, 0.0, 1.0));
                 }
             buffer->WriteFloats(depth, 1);
-        } else if (name == HdAovTokens->primId || name == HdAovTokens->instanceId || name == HdAovTokens->elementId) {
-            // XXX: the core does not report which prim a pixel saw yet; -1 is "nothing".
-            buffer->WriteInts(std::vector<int>(static_cast<size_t>(film.width()) * film.height(), -1));
+        } else if (name == HdAovTokens->primId) {
+            // What the pixel-centre ray met first (Renderer::pixelIds): the rprim's prim id, its
+            // instance index and authored face, as hdEmbree reports them; -1 where it met nothing.
+            buffer->WriteInts(film.resolveIds(Film::ObjectId));
+        } else if (name == HdAovTokens->instanceId) {
+            buffer->WriteInts(film.resolveIds(Film::InstanceId));
+        } else if (name == HdAovTokens->elementId) {
+            buffer->WriteInts(film.resolveIds(Film::ElementId));
         } else {
             static const std::pair<char const *, Film::Aov> split[] = {
                 {"single", Film::Single}, {"multiple", Film::Multiple}, {"emission", Film::Emission}, {"surface", Film::Surface}};

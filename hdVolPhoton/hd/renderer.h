@@ -22,6 +22,14 @@ PXR_NAMESPACE_OPEN_SCOPE
 /// render thread then calls Render(), which runs core passes until samplesPerPixel is reached or a
 /// stop is requested, writing resolved AOVs into the bound render buffers after every pass under
 /// the framebuffer lock. Pausing is honoured between passes.
+///
+/// Interactive restarts: before the first pass, when the last full pass took longer than
+/// PreviewAfterSeconds (or no pass was timed yet), a coarse preview (volphoton::Renderer::renderPreview:
+/// one path-traced sample per block x block pixels, the block chosen so the preview costs about
+/// PreviewTargetSeconds) is written to the buffers. It is not part of the accumulation: the first
+/// full pass overwrites it and the converged image is the same as without it (usdrecord's final
+/// image never shows it). Stats: framesWritten counts buffer updates since the restart, previewBlock
+/// is the block of the preview shown (0: none). HDVOLPHOTON_PREVIEW=0 (debug knob) turns previews off.
 class HdVolPhoton_Renderer
 {
 public:
@@ -31,8 +39,12 @@ public:
     bool IsConverged() const;
     VtDictionary GetStats() const;
 
+    static constexpr double PreviewAfterSeconds = 0.03, PreviewTargetSeconds = 0.01;
+
 private:
     void _WriteAovs(volphoton::Film const &film);
+    /// Block size of the preview before the first pass; 1: no preview.
+    int _PreviewBlock() const;
 
     std::shared_ptr<volphoton::Scene const> _scene;
     volphoton::RenderSettings _settings;
@@ -41,6 +53,9 @@ private:
     mutable std::mutex _statsMutex;
     volphoton::RenderStats _stats;
     bool _converged = false;
+    int _framesWritten = 0, _previewBlock = 0;
+    bool _previewEnabled = true;
+    double _lastPassSeconds = -1;  ///< render thread only; kept across restarts (-1: none timed yet)
 };
 
 PXR_NAMESPACE_CLOSE_SCOPE

@@ -88,15 +88,18 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
         if (rec.instances.empty()) continue;
         // The mesh's own faces, then one part per material-bound GeomSubset (media ignore subsets).
         std::vector<std::pair<SdfPath, MeshDesc>> parts{{rec.materialId, rec.mesh}};
-        for (auto const &[materialId, indices] : rec.subsets) {
+        for (HdVolPhoton_SubsetRecord const &subset : rec.subsets) {
             if (rec.hasMedium) {
-                parts[0].second.indices.insert(parts[0].second.indices.end(), indices.begin(), indices.end());
+                MeshDesc &whole = parts[0].second;
+                whole.indices.insert(whole.indices.end(), subset.indices.begin(), subset.indices.end());
+                whole.triangleElements.insert(whole.triangleElements.end(), subset.faces.begin(), subset.faces.end());
                 continue;
             }
             MeshDesc part = rec.mesh;
-            part.name = id.GetString() + ":" + materialId.GetName();
-            part.indices = indices;
-            parts.push_back({materialId, std::move(part)});
+            part.name = id.GetString() + ":" + subset.materialId.GetName();
+            part.indices = subset.indices;
+            part.triangleElements = subset.faces;
+            parts.push_back({subset.materialId, std::move(part)});
         }
         for (auto &[materialId, mesh] : parts) {
             if (mesh.indices.empty()) continue;
@@ -120,7 +123,9 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
             }
             d.meshes.push_back(std::move(mesh));
             int index = static_cast<int>(d.meshes.size()) - 1;
-            for (Affine const &xf : rec.instances) d.instances.push_back({index, xf});
+            // The ids hdEmbree reports: the rprim's prim id and the instance's index (0 when not instanced).
+            for (size_t i = 0; i < rec.instances.size(); ++i)
+                d.instances.push_back({index, rec.instances[i], rec.primId, static_cast<int>(i)});
         }
     }
     for (auto const &[id, rec] : _volumes) {

@@ -15,16 +15,23 @@
 
 PXR_NAMESPACE_OPEN_SCOPE
 
+/// A GeomSubset with a material binding: its triangles (3 vertex indices each) and their authored faces.
+struct HdVolPhoton_SubsetRecord {
+    SdfPath materialId;
+    std::vector<uint32_t> indices;
+    std::vector<int> faces;  ///< one per triangle
+};
+
 /// A mesh as synced: object-space triangles, one world transform per instance, its surface and,
 /// when it carries VolPhotonMediumAPI, the medium it bounds.
 struct HdVolPhoton_MeshRecord {
-    volphoton::MeshDesc mesh;                  ///< object space; interiorMedium set by the registry
+    volphoton::MeshDesc mesh;                  ///< object space (triangleElements: authored faces); interiorMedium set by the registry
     std::vector<volphoton::Affine> instances;  ///< world transforms (one when not instanced)
+    int primId = -1;  ///< HdRprim::GetPrimId(): what the primId AOV reports (instanceId: index into instances)
     bool hasMedium = false;
     HdVolPhoton_MediumParams medium;
     SdfPath materialId;  ///< bound material of the faces in no subset
-    /// GeomSubsets with a material binding: (material, their triangles' vertex indices, 3 per triangle).
-    std::vector<std::pair<SdfPath, std::vector<uint32_t>>> subsets;
+    std::vector<HdVolPhoton_SubsetRecord> subsets;
 };
 
 /// A material as synced: valid when it had a UsdPreviewSurface; material empty = not rendered.

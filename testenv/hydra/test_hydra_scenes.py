@@ -125,10 +125,9 @@ def test_broken_scene_warns_naming_prims_and_still_renders(tmp_path, hydra_env):
                                       "--imageWidth", "32", str(tmp_path / "broken.usda"), out], scene_index=scene_index)
         log = r.stdout + r.stderr
         assert r.returncode == 0 and os.path.exists(out), log
-        # XXX: on the scene-index path (OpenUSD 24.08) the sphere with a NaN transform never reaches
-        # the delegate with it (nothing of it is rendered and no warning is ours); the legacy scene
-        # delegate hands it over and the delegate names it.
-        for prim in ("/World/missingVdb", "/World/wrongField") + (() if scene_index else ("/World/nanXform",)):
+        # Both paths hand the sphere with a NaN transform over as a mesh (the scene-index path through
+        # the delegate's implicit-surface scene-index plug-in) and the delegate names it.
+        for prim in ("/World/missingVdb", "/World/wrongField", "/World/nanXform"):
             assert prim in log, (scene_index, prim, log)
         image = rgb(out)
         assert np.isfinite(image).all() and image.max() > 0  # the dome and the fine sphere still render

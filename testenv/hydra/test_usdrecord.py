@@ -80,11 +80,11 @@ def render_cli(stage, out):
     return rgb(out)
 
 
-def render_hydra(hydra_env, stage, settings_path, camera, out):
+def render_hydra(hydra_env, stage, settings_path, camera, out, scene_index=False):
     # usdrecord takes the image width from --imageWidth (the settings prim has no render products)
     # and the height from the camera's aspect ratio.
     r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", settings_path, "--enableDomeLightVisibility",
-                                  "--camera", camera, "--imageWidth", SIZE[0], stage, out], scene_index=False)
+                                  "--camera", camera, "--imageWidth", SIZE[0], stage, out], scene_index=scene_index)
     assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
     return rgb(out)
 
@@ -120,3 +120,20 @@ def test_usdrecord_matches_the_standalone_front_end(tmp_path, hydra_env, scene):
     z = block_z(hyd, cli)
     assert (z ** 2).mean() < 3 and np.abs(z).max() < 10, (scene, (z ** 2).mean(), np.abs(z).max(),
                                                           hyd.mean(axis=(0, 1, 2)), cli.mean(axis=(0, 1, 2)))
+
+
+# XXX: OpenUSD 24.08's scene-index path emits nothing for UsdGeomPlane prims (UsdImagingPlaneAdapter
+# has no data-source support: "Datasource support not yet added"), so scenes with a Plane render
+# without it there. Every other scene arrives the same on both paths.
+SCENE_INDEX_SCENES = [s for s in SCENES if "def Plane " not in open(os.path.join(TESTENV, s)).read()]
+
+
+@pytest.mark.parametrize("scene", SCENE_INDEX_SCENES)
+def test_scene_index_path_renders_like_the_default_path(tmp_path, hydra_env, scene):
+    """USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX=1: the same prims reach the delegate, so with the same
+    seed the image is bit-identical to the default (legacy scene delegate) path."""
+    stage, settings_path, camera = wrapper(tmp_path, scene, SEEDS[0])
+    default = render_hydra(hydra_env, stage, settings_path, camera, str(tmp_path / "default.exr"))
+    indexed = render_hydra(hydra_env, stage, settings_path, camera, str(tmp_path / "index.exr"), scene_index=True)
+    assert default.shape == indexed.shape
+    assert np.array_equal(default, indexed), "max difference %g" % np.abs(default - indexed).max()

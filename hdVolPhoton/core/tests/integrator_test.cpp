@@ -680,3 +680,82 @@ TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
         EXPECT_GT(lit, 0.0);
     }
 }
+
+TEST(IntegratorIds, PixelCentreRayReportsTheFirstVisibleSurface) {
+    // Two quads at z = 0 (lower left: object 7, elements given; lower right: object 9, instance 2)
+    // behind an index-matched boundary quad at z = 1 (object 5) that covers the middle of the image.
+    // Pixels see through the boundary to a quad where there is one, the boundary where there is
+    // none, and -1 outside both. The ids do not depend on the seed (pixel-centre ray, pass 0).
+    auto quad = [](double x0, double x1, double y0, double y1, double z) {
+        MeshDesc m;
+        m.points = {Vec3(x0, y0, z), Vec3(x1, y0, z), Vec3(x1, y1, z), Vec3(x0, y1, z)};
+        m.indices = {0, 1, 2, 0, 2, 3};
+        return m;
+    };
+    SceneDesc d;
+    d.meshes.push_back(quad(-1.5, -0.1, -1.5, 0.0, 0.0));
+    d.meshes[0].triangleElements = {4, 4};
+    d.meshes.push_back(quad(0.1, 1.5, -1.5, 0.0, 0.0));
+    d.meshes.push_back(quad(-1.5, 1.5, -1.0, 1.0, 1.0));
+    d.meshes[2].material.kind = SurfaceMaterial::Kind::Boundary;
+    d.instances = {{0, Affine(), 7, 0}, {1, Affine(), 9, 2}, {2, Affine(), 5, 0}};
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0));
+    auto scene = std::make_shared<Scene>(d);
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap})
+        for (uint64_t seed : {1u, 2u}) {
+            RenderSettings s = smallSettings(integrator, 2, seed);
+            s.width = s.height = 16;
+            Renderer r(scene, s);
+            r.render();
+            const Film& f = r.film();
+            auto at = [&](int x, int y) { return f.ids(x, y); };
+            EXPECT_EQ(at(3, 12).object, 7);
+            EXPECT_EQ(at(3, 12).instance, 0);
+            EXPECT_EQ(at(3, 12).element, 4);
+            EXPECT_EQ(at(12, 12).object, 9);
+            EXPECT_EQ(at(12, 12).instance, 2);
+            EXPECT_TRUE(at(12, 12).element == 0 || at(12, 12).element == 1);
+            EXPECT_EQ(at(8, 3).object, 5);
+            EXPECT_EQ(at(0, 0).object, -1);
+            EXPECT_EQ(at(0, 0).instance, -1);
+            EXPECT_EQ(at(0, 0).element, -1);
+            std::vector<int> objects = f.resolveIds(Film::ObjectId);
+            EXPECT_EQ(objects[12 * 16 + 3], 7);
+            EXPECT_EQ(f.resolveIds(Film::InstanceId)[12 * 16 + 12], 2);
+        }
+}
+
+TEST(IntegratorPreview, CoarsePreviewFillsBlocksAndLeavesTheRenderUnchanged) {
+    // A preview between passes must not change the progressive film (bit-identical), and fills
+    // every pixel of each block with its one sample.
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}),
+                                   Vec3(0.2, 0.1, 3));
+        auto scene = std::make_shared<Scene>(d);
+        RenderSettings s = smallSettings(integrator, 3, 5);
+        s.width = 18;
+        s.height = 11;  // not a multiple of the block: partial blocks at the edges
+        Renderer plain(scene, s), previewed(scene, s);
+        plain.render();
+        Film preview(s.width, s.height);
+        ASSERT_TRUE(previewed.renderPreview(4, preview));
+        for (int pass = 0; pass < s.samplesPerPixel; ++pass) {
+            ASSERT_TRUE(previewed.renderPass());
+            ASSERT_TRUE(previewed.renderPreview(4, preview));
+        }
+        EXPECT_EQ(plain.film().resolveRgb(Film::Beauty), previewed.film().resolveRgb(Film::Beauty));
+        EXPECT_EQ(plain.film().resolveIds(Film::ObjectId), previewed.film().resolveIds(Film::ObjectId));
+        EXPECT_EQ(plain.stats().passes, previewed.stats().passes);
+        auto rgb = preview.resolveRgb(Film::Beauty);
+        for (int y = 0; y < s.height; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                EXPECT_EQ(preview.samples(x, y), 1u);
+                size_t i = 3 * (static_cast<size_t>(y) * s.width + x), b = 3 * (static_cast<size_t>(y / 4 * 4) * s.width + x / 4 * 4);
+                EXPECT_EQ(rgb[i], rgb[b]) << x << "," << y;
+            }
+        Film wrongSize(4, 4);
+        EXPECT_THROW(previewed.renderPreview(4, wrongSize), std::invalid_argument);
+    }
+}

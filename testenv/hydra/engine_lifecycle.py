@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): pause, resume,
+stop, convergence, restart on a camera change, and when the coarse preview is shown. Run by
+test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
+PXR_PLUGINPATH_NAME:
+
+    python3 engine_lifecycle.py SCENE.usda CAMERA_PATH
+
+Exits 0 when every check holds; otherwise prints the failed check and exits 1. About 5 s.
+"""
+
+import sys
+import time
+
+from pxr import CameraUtil, Gf, Sdf, Usd, UsdGeom, UsdImagingGL
+
+SIZE = (64, 36)
+QUIET = 0.5  # seconds a stopped or paused render must not advance
+
+
+def check(condition, what):
+    if not condition:
+        print("FAILED:", what)
+        sys.exit(1)
+
+
+def main(scene, camera_path):
+    stage = Usd.Stage.Open(scene)
+    params = UsdImagingGL.Engine.Parameters()
+    params.gpuEnabled = False
+    engine = UsdImagingGL.Engine(params)
+    check(engine.SetRendererPlugin("HdVolPhotonRendererPlugin"), "the VolPhoton plug-in loads")
+    check(engine.IsPauseRendererSupported() and engine.IsStopRendererSupported(), "pause and stop are supported")
+    engine.SetRendererAov("color")
+    engine.SetRenderBufferSize(Gf.Vec2i(*SIZE))
+    engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), SIZE[0], SIZE[1])))
+    camera = UsdGeom.Camera(stage.GetPrimAtPath(camera_path)).GetCamera(Usd.TimeCode.Default())
+    f = camera.frustum
+    CameraUtil.ConformWindow(f, CameraUtil.MatchVertically, SIZE[0] / SIZE[1])
+    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    root, render_params = stage.GetPseudoRoot(), UsdImagingGL.RenderParams()
+
+    def stats():
+        engine.Render(root, render_params)
+        return engine.GetRenderStats()
+
+    def passes():
+        return int(stats().get("passes", 0))
+
+    def render_until(predicate, timeout=20.0):
+        t0 = time.perf_counter()
+        while not predicate():
+            check(time.perf_counter() - t0 < timeout, "reached within %.0f s" % timeout)
+            time.sleep(0.005)
+
+    def quiet_for(seconds):
+        """Passes at the start and the end of `seconds` of Render() calls."""
+        first = passes()
+        t0 = time.perf_counter()
+        while time.perf_counter() - t0 < seconds:
+            passes()
+            time.sleep(0.01)
+        return first, passes()
+
+    # Converges at convergedSamplesPerPixel and stays there. (Set after the first Render(): the
+    # scene's RenderSettings prim, synced then, sets it too.)
+    # The first render has no pass time to go by: a 4x4-block preview comes before the first pass.
+    render_until(lambda: stats()["framesWritten"] >= 2)
+    check(stats()["previewBlock"] == 4, "the first render starts with a 4x4 preview: %s" % stats()["previewBlock"])
+    engine.SetRendererSetting("convergedSamplesPerPixel", 4)
+    render_until(lambda: passes() > 0 and engine.IsConverged())
+    s = stats()
+    check(s["passes"] == 4 and s["percentDone"] == 100.0, "converged after exactly 4 passes: %s" % s["passes"])
+    # Passes at 64x36 take milliseconds: a restart then shows no preview, only the 4 passes.
+    check(s["previewBlock"] == 0 and s["framesWritten"] == 4, "no preview after fast passes: %s" % s)
+    a, b = quiet_for(0.2)
+    check(a == b == 4 and engine.IsConverged(), "a converged render stays converged")
+
+    # Keep rendering: many passes to go.
+    engine.SetRendererSetting("convergedSamplesPerPixel", 100000)
+    render_until(lambda: passes() >= 3)
+    check(not engine.IsConverged(), "not converged while passes remain")
+
+    check(engine.PauseRenderer(), "PauseRenderer")
+    time.sleep(0.2)  # the pass in flight completes; the next one does not start
+    a, b = quiet_for(QUIET)
+    check(a == b, "paused: passes did not advance (%d -> %d)" % (a, b))
+    check(not engine.IsConverged(), "a paused render is not converged")
+
+    check(engine.ResumeRenderer(), "ResumeRenderer")
+    render_until(lambda: passes() >= b + 2)
+
+    check(engine.StopRenderer(), "StopRenderer")
+    a, b = quiet_for(QUIET)
+    check(a == b, "stopped: passes did not advance (%d -> %d)" % (a, b))
+    check(not engine.IsConverged(), "a stopped render is not converged")
+
+    # A camera change restarts the render (the pass counter starts again), even after a stop.
+    before, version = b, stats()["sceneVersion"]
+    f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), 3.0)))
+    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    restarted = []
+    render_until(lambda: restarted.append(passes()) or restarted[-1] < before)
+    render_until(lambda: passes() >= 2)
+    check(stats()["sceneVersion"] == version, "a camera change does not rebuild the scene version")
+    engine.StopRenderer()
+    print("OK")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(*sys.argv[1:]))
