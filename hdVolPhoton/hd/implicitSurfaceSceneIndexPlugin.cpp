@@ -5,27 +5,37 @@
 #include "pxr/imaging/hd/tokens.h"
 #include "pxr/imaging/hdsi/implicitSurfaceSceneIndex.h"
 
+#include <array>
+
 PXR_NAMESPACE_OPEN_SCOPE
 
 namespace {
-TfToken const &_PluginName() {
+
+/// The type name the plug-in is registered under (the key in plugInfo.json).
+TfToken const &_TypeName() {
     static TfToken const name("HdVolPhoton_ImplicitSurfaceSceneIndexPlugin");
     return name;
 }
-char const *const _rendererDisplayName = "VolPhoton";  // plugInfo.json's displayName of the renderer
+
+/// HdsiImplicitSurfaceSceneIndex's arguments: every implicit type the delegate meets, to a mesh.
+HdContainerDataSourceHandle _ToMeshArguments() {
+    std::array<TfToken, 5> const types = {HdPrimTypeTokens->sphere, HdPrimTypeTokens->cube, HdPrimTypeTokens->cone,
+                                          HdPrimTypeTokens->cylinder, HdPrimTypeTokens->capsule};
+    HdDataSourceBaseHandle const mesh = HdRetainedTypedSampledDataSource<TfToken>::New(HdsiImplicitSurfaceSceneIndexTokens->toMesh);
+    std::array<HdDataSourceBaseHandle, 5> values;
+    values.fill(mesh);
+    return HdRetainedContainerDataSource::New(types.size(), types.data(), values.data());
+}
+
 }  // namespace
 
 TF_REGISTRY_FUNCTION(TfType) { HdSceneIndexPluginRegistry::Define<HdVolPhoton_ImplicitSurfaceSceneIndexPlugin>(); }
 
 TF_REGISTRY_FUNCTION(HdSceneIndexPlugin) {
-    HdDataSourceBaseHandle const toMesh =
-        HdRetainedTypedSampledDataSource<TfToken>::New(HdsiImplicitSurfaceSceneIndexTokens->toMesh);
-    HdContainerDataSourceHandle const inputArgs =
-        HdRetainedContainerDataSource::New(HdPrimTypeTokens->sphere, toMesh, HdPrimTypeTokens->cube, toMesh,
-                                           HdPrimTypeTokens->cone, toMesh, HdPrimTypeTokens->cylinder, toMesh,
-                                           HdPrimTypeTokens->capsule, toMesh);
+    // For the renderer whose plugInfo displayName is "VolPhoton", first in phase 0, so that every
+    // later scene index already sees meshes.
     HdSceneIndexPluginRegistry::GetInstance().RegisterSceneIndexForRenderer(
-        _rendererDisplayName, _PluginName(), inputArgs, 0, HdSceneIndexPluginRegistry::InsertionOrderAtStart);
+        "VolPhoton", _TypeName(), _ToMeshArguments(), /*insertionPhase=*/0, HdSceneIndexPluginRegistry::InsertionOrderAtStart);
 }
 
 HdVolPhoton_ImplicitSurfaceSceneIndexPlugin::HdVolPhoton_ImplicitSurfaceSceneIndexPlugin() = default;

@@ -5,6 +5,9 @@
 #include "pxr/imaging/hd/resourceRegistry.h"
 #include "pxr/imaging/hd/tokens.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/diagnostics.h"
 #include "hd/field.h"
 #include "hd/instancer.h"
@@ -75,6 +78,13 @@ void HdVolPhotonRenderDelegate::_Initialize() {
     add("Single scattering pass", HdVolPhotonRenderSettingsTokens->singleScattering, VtValue(d.singleScattering));
     add("Multiple scattering pass", HdVolPhotonRenderSettingsTokens->multipleScattering, VtValue(d.multipleScattering));
     add("Seed", HdVolPhotonRenderSettingsTokens->seed, VtValue(static_cast<int>(d.seed)));
+    add("Russian roulette depth", HdVolPhotonRenderSettingsTokens->rouletteDepth, VtValue(d.rouletteDepth));
+    add("Stratified dimensions (0: independent)", HdVolPhotonRenderSettingsTokens->stratifiedDims, VtValue(d.stratifiedDims));
+    add("Photon radius reduction (alpha)", HdVolPhotonRenderSettingsTokens->radiusAlpha, VtValue(static_cast<float>(d.radiusAlpha)));
+    add("Photon radius cap (mean free paths)", HdVolPhotonRenderSettingsTokens->photonRadiusMfp, VtValue(static_cast<float>(d.photonRadiusMfp)));
+    add("March step (0: auto)", HdVolPhotonRenderSettingsTokens->marchStep, VtValue(static_cast<float>(d.marchStep)));
+    add("Multiple-scattering threshold", HdVolPhotonRenderSettingsTokens->multipleThreshold, VtValue(static_cast<float>(d.multipleThreshold)));
+    add("Transmittance cut-off (biased)", HdVolPhotonRenderSettingsTokens->transmittanceCutoff, VtValue(static_cast<float>(d.transmittanceCutoff)));
     _PopulateDefaultSettings(_settingDescriptors);
     _renderThread.SetRenderCallback([this]() { _renderer.Render(&_renderThread); });
     _renderThread.StartThread();
@@ -100,6 +110,31 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     // usdrecord hides domes from the camera unless --enableDomeLightVisibility; usdview shows them.
     s.domeVisibleToCamera = GetRenderSetting<bool>(HdRenderSettingsTokens->domeLightCameraVisibility, true);
     s.seed = static_cast<uint64_t>(std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->seed, 0)));
+    // The numeric settings below come from RenderSettings prims as whatever type was authored.
+    auto number = [this](TfToken const &key, double fallback, double lo, double hi) {
+        VtValue v = GetRenderSetting(key);
+        double x = fallback;
+        if (v.IsHolding<double>()) x = v.UncheckedGet<double>();
+        else if (v.IsHolding<float>()) x = v.UncheckedGet<float>();
+        else if (v.IsHolding<int>()) x = v.UncheckedGet<int>();
+        else if (v.IsHolding<int64_t>()) x = static_cast<double>(v.UncheckedGet<int64_t>());
+        else if (v.IsHolding<unsigned int>()) x = v.UncheckedGet<unsigned int>();
+        else if (!v.IsEmpty()) TF_WARN("hdVolPhoton: render setting %s has type %s; using %g", key.GetText(), v.GetTypeName().c_str(), fallback);
+        if (!(x >= lo && x <= hi)) {
+            double c = std::isnan(x) ? fallback : std::clamp(x, lo, hi);
+            TF_WARN("hdVolPhoton: render setting %s = %g is outside [%g, %g]; using %g", key.GetText(), x, lo, hi, c);
+            x = c;
+        }
+        return x;
+    };
+    constexpr double Big = 1e9;
+    s.rouletteDepth = static_cast<int>(number(HdVolPhotonRenderSettingsTokens->rouletteDepth, s.rouletteDepth, 0, Big));
+    s.stratifiedDims = static_cast<int>(number(HdVolPhotonRenderSettingsTokens->stratifiedDims, s.stratifiedDims, 0, 4096));
+    s.radiusAlpha = number(HdVolPhotonRenderSettingsTokens->radiusAlpha, s.radiusAlpha, 1e-6, 1);
+    s.photonRadiusMfp = number(HdVolPhotonRenderSettingsTokens->photonRadiusMfp, s.photonRadiusMfp, 0, Big);
+    s.marchStep = number(HdVolPhotonRenderSettingsTokens->marchStep, s.marchStep, 0, Big);
+    s.multipleThreshold = number(HdVolPhotonRenderSettingsTokens->multipleThreshold, s.multipleThreshold, 0, Big);
+    s.transmittanceCutoff = number(HdVolPhotonRenderSettingsTokens->transmittanceCutoff, s.transmittanceCutoff, 0, 1);
     return s;
 }
 

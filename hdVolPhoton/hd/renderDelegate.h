@@ -29,6 +29,14 @@ class HdVolPhotonRenderParam;
 /// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |
 /// | volphoton:multipleScattering | bool  | true       | photonMap: photon pass on/off                |
 /// | volphoton:seed               | int   | 0          | random seed                                  |
+/// | volphoton:rouletteDepth      | int   | 3          | events before Russian roulette               |
+/// | volphoton:stratifiedDims     | int   | 32         | draws per camera sample from Sobol' points   |
+/// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
+/// | volphoton:photonRadiusMfp    | float | 1          | photonMap: kernel cap in mean free paths     |
+/// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
+/// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
+/// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |
+/// Numbers may be authored as int, float or double; out-of-range values are clamped with a warning.
 #define HDVOLPHOTON_RENDER_SETTINGS_TOKENS \
     ((integrator, "volphoton:integrator"))  \
     ((maxDepth, "volphoton:maxDepth"))      \
@@ -37,6 +45,13 @@ class HdVolPhotonRenderParam;
     ((singleScattering, "volphoton:singleScattering")) \
     ((multipleScattering, "volphoton:multipleScattering")) \
     ((seed, "volphoton:seed"))              \
+    ((rouletteDepth, "volphoton:rouletteDepth")) \
+    ((stratifiedDims, "volphoton:stratifiedDims")) \
+    ((radiusAlpha, "volphoton:radiusAlpha")) \
+    ((photonRadiusMfp, "volphoton:photonRadiusMfp")) \
+    ((marchStep, "volphoton:marchStep")) \
+    ((multipleThreshold, "volphoton:multipleThreshold")) \
+    ((transmittanceCutoff, "volphoton:transmittanceCutoff")) \
     (pathTracer)                            \
     (photonMap)
 

@@ -158,3 +158,32 @@ def test_dome_hidden_from_the_camera_unless_asked(tmp_path, hydra_env):
         means[visible] = (float(image[0, 0].mean()), float(image.mean()))
     assert means[True][0] == 1.0 and means[False][0] == 0.0, means  # a corner pixel: the dome directly
     assert 0 < means[False][1] < means[True][1], means               # the lit medium remains
+
+
+def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
+    """volphoton:* settings beyond the basic ones (here stratifiedDims, authored as int and as double,
+    and an out-of-range radiusAlpha) reach the core through the render-settings Bprim: the same
+    seed renders bit-identically with the default value spelled out, differently with another value,
+    and an out-of-range value is clamped with a warning naming the setting."""
+    base = open(os.path.join(TESTENV, "furnace.usda")).read()
+    base = base.replace("int2 resolution = (32, 32)", "int2 resolution = (16, 16)")
+    base = base.replace("int volphoton:samplesPerPixel = 16", "int volphoton:samplesPerPixel = 4")
+    anchor = "int volphoton:maxDepth = 1000"
+    assert anchor in base
+    variants = {"default": "", "same": "int volphoton:stratifiedDims = 32", "asdouble": "double volphoton:stratifiedDims = 32",
+                "independent": "int volphoton:stratifiedDims = 0",
+                "badalpha": 'float volphoton:radiusAlpha = 7\n        token volphoton:integrator = "photonMap"'}
+    images, logs = {}, {}
+    for name, extra in variants.items():
+        path = tmp_path / (name + ".usda")
+        path.write_text(base.replace(anchor, anchor + "\n        " + extra))
+        out = str(tmp_path / (name + ".exr"))
+        r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility",
+                                      "--camera", "/World/camera", "--imageWidth", "16", str(path), out])
+        assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
+        images[name], logs[name] = rgb(out), r.stdout + r.stderr
+    assert np.array_equal(images["default"], images["same"])
+    assert np.array_equal(images["default"], images["asdouble"])
+    assert not np.array_equal(images["default"], images["independent"])
+    assert "volphoton:radiusAlpha = 7 is outside" in logs["badalpha"], logs["badalpha"]
+    assert np.isfinite(images["badalpha"]).all() and abs(images["badalpha"].mean() - 1) < 0.1

@@ -78,6 +78,13 @@ SceneDesc furnaceScene(MediumPtr medium, const Vec3& eye) {
     return d;
 }
 
+/// A unit cube of sigma_t 2, albedo 0.9, isotropic, under a dome of radiance 1, seen from (0.2, 0.1, 3).
+std::shared_ptr<Scene> domeLitCubeScene() {
+    auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+    return std::make_shared<Scene>(furnaceScene(
+        std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}), Vec3(0.2, 0.1, 3)));
+}
+
 std::vector<std::pair<std::string, PhasePtr>> allPhases() {
     std::vector<double> table;
     for (int i = 0; i < 33; ++i) table.push_back(0.3 + std::exp(3.0 * (-1 + 2.0 * i / 32)));
@@ -651,10 +658,7 @@ TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
     // random decisions, so no pixel gets brighter, pixels no sample of which met the medium are 0,
     // and the lit cube is still there.
     for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
-        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
-        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}),
-                                   Vec3(0.2, 0.1, 3));
-        auto scene = std::make_shared<Scene>(d);
+        auto scene = domeLitCubeScene();
         RenderSettings s = smallSettings(integrator, 4, 7);
         s.width = s.height = 16;
         Renderer visible(scene, s);
@@ -730,10 +734,7 @@ TEST(IntegratorPreview, CoarsePreviewFillsBlocksAndLeavesTheRenderUnchanged) {
     // A preview between passes must not change the progressive film (bit-identical), and fills
     // every pixel of each block with its one sample.
     for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
-        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
-        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)}),
-                                   Vec3(0.2, 0.1, 3));
-        auto scene = std::make_shared<Scene>(d);
+        auto scene = domeLitCubeScene();
         RenderSettings s = smallSettings(integrator, 3, 5);
         s.width = 18;
         s.height = 11;  // not a multiple of the block: partial blocks at the edges
