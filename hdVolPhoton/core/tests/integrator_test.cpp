@@ -478,7 +478,13 @@ TEST(IntegratorSkips, WhatTheSceneDoesNotNeedIsSkippedAndSaid) {
     Renderer r1(std::make_shared<Scene>(noMedia), smallSettings(RenderSettings::Integrator::PhotonMap, 1, 0));
     r1.render();
     EXPECT_TRUE(has(r1.stats().passesSkipped, "multiple scattering (photons): the scene has no media"));
+    EXPECT_TRUE(has(r1.stats().passesSkipped, "photon-map camera paths: the scene has no media"));
     EXPECT_EQ(r1.stats().photonsTraced, 0u);
+    {  // ... and the picture is the path tracer's, bit for bit (same seed).
+        Renderer pt(std::make_shared<Scene>(noMedia), smallSettings(RenderSettings::Integrator::PathTracer, 1, 0));
+        pt.render();
+        EXPECT_EQ(pt.film().resolveRgb(Film::Beauty), r1.film().resolveRgb(Film::Beauty));
+    }
 
     SceneDesc thin = mediaOnlyScene();
     thin.media[0] = std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(0.01, Spectrum(1.0), Spectrum(0.05), Spectrum(0.0), makeIsotropicPhase()),
