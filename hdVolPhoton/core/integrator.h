@@ -17,7 +17,7 @@
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the scene diameter)                               |
 // | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
-// | photonRadiusMfp     | double | 1          | mean free    | photonMap: a photon's radius is at most this many |
+// | photonRadiusMfp     | double | 8          | mean free    | photonMap: a photon's radius is at most this many |
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
 // |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
@@ -71,7 +71,7 @@ struct RenderSettings {
     int photonsPerPass = 100000;
     double initialRadius = 0;
     double radiusAlpha = 0.7;
-    double photonRadiusMfp = 1;
+    double photonRadiusMfp = 8;
     int stratifiedDims = 32;
     double marchStep = 0;
     bool singleScattering = true;

@@ -32,7 +32,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:rouletteDepth      | int   | 3          | events before Russian roulette               |
 /// | volphoton:stratifiedDims     | int   | 32         | draws per camera sample from Sobol' points   |
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
-/// | volphoton:photonRadiusMfp    | float | 1          | photonMap: kernel cap in mean free paths     |
+/// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
 /// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
 /// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |
