@@ -204,6 +204,21 @@ private:
         double supportStart = Infinity, supportEnd = 0;
         bool stop = false;
         double offsetU = rng.uniform();
+        // One step's share of the segment: emission and single scattering at p, with transmittance T
+        // from the segment start, times `measure` (dt x weight for a marched step).
+        auto addStep = [&](const Vec3& p, const MediumProperties& mp, const Spectrum& T, const Spectrum& measure) {
+            if (!mp.sigma_t().isBlack()) r.interacted = true;
+            if (emissive) r.emission += mp.emission * T * measure;
+            if (single && hasExtended_ && !mp.sigma_s.isBlack()) {
+                // Light sampling costs a shadow ray. Steps whose weight sigma_s T measure is tiny (the
+                // march resolves the majorant, so at a dense grid's edge thousands of steps cross a ramp
+                // of little density) sample it with probability weight / NeeWeight and divide by that
+                // probability: unbiased, and ordinary steps (weight >= 1e-5) are unaffected.
+                constexpr double NeeWeight = 1e-5;
+                double q = std::min(1.0, (mp.sigma_s * T * measure).maxValue() / NeeWeight);
+                if (q >= 1 || rng.uniform() < q) r.single += directExtended(p, ray.d, mp, stack, rng) * T * measure / q;
+            }
+        };
         media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
             supportStart = std::min(supportStart, seg.tMin);
             supportEnd = std::max(supportEnd, seg.tMax);
@@ -225,15 +240,12 @@ private:
                     // Close the segment with the step integral of a homogeneous layer,
                     // int_0^inf x e^{-sigma_t s} ds = x / sigma_t per channel, and stop (T = 0).
                     // Summing x T dt over steps that do not move would add up without bound.
-                    MediumProperties mp = media.properties(ray.at(t0));
+                    Vec3 p = ray.at(t0);
+                    MediumProperties mp = media.properties(p);
                     Spectrum sigma_t = mp.sigma_t();
-                    Spectrum T = tr.closedForm ? tr.at(t0) : exp(-tauRun);
                     Spectrum invSigma;
                     for (int c = 0; c < 3; ++c) invSigma[c] = sigma_t[c] > 0 ? 1 / sigma_t[c] : 0.0;
-                    if (!sigma_t.isBlack()) r.interacted = true;
-                    if (emissive) r.emission += mp.emission * invSigma * T * weight;
-                    if (single && hasExtended_ && !mp.sigma_s.isBlack())
-                        r.single += directExtended(ray.at(t0), ray.d, mp, stack, rng) * invSigma * T * weight;
+                    addStep(p, mp, tr.closedForm ? tr.at(t0) : exp(-tauRun), invSigma * weight);
                     stop = true;
                     break;
                 }
@@ -248,20 +260,7 @@ private:
                     tr.t.push_back(t0);
                     for (int c = 0; c < 3; ++c) tr.tau[c].push_back(tauRun[c]);
                 }
-                if (!sigma_t.isBlack()) r.interacted = true;
-                if (emissive) r.emission += mp.emission * T * (dt * weight);
-                if (single && hasExtended_ && !mp.sigma_s.isBlack()) {
-                    // Light sampling costs a shadow ray. Steps whose weight sigma_s T dt is tiny (the
-                    // march resolves the majorant, so at a dense grid's edge thousands of steps cross
-                    // a ramp of little density) sample it with probability weight / NeeWeight and
-                    // divide by that probability: unbiased, and ordinary steps (weight >= 1e-5) are
-                    // unaffected.
-                    constexpr double NeeWeight = 1e-5;
-                    double stepWeight = (mp.sigma_s * T).maxValue() * dt * weight;
-                    double q = std::min(1.0, stepWeight / NeeWeight);
-                    if (q >= 1 || rng.uniform() < q)
-                        r.single += directExtended(p, ray.d, mp, stack, rng) * T * (dt * weight / q);
-                }
+                addStep(p, mp, T, Spectrum(dt * weight));
                 // Early termination of the march.
                 double Tmax = T.maxValue() * weight;
                 if (Tmax < settings_.transmittanceCutoff) { stop = true; break; }
