@@ -77,7 +77,7 @@ Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double di
         stack.toggle(hit.mesh);
         travelled += hit.t;
         ray.o = hit.p;
-        tMin = spawnTMin(hit, w);
+        tMin = scene_.spawnTMin(hit, w);
     }
     return Spectrum(0.0);
 }
@@ -103,7 +103,7 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
     double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
     // The light must be on the viewer's side of the geometric surface too (no light leaks through).
     if (!(cosL > 0) || !(ds.ls.pdf > 0) || ds.ls.Li.isBlack() || dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
-    Spectrum T = shadowTransmittance(hit.p, ds.ls.wi, ds.ls.dist, stack, rng, spawnTMin(hit, ds.ls.wi));
+    Spectrum T = shadowTransmittance(hit.p, ds.ls.wi, ds.ls.dist, stack, rng, scene_.spawnTMin(hit, ds.ls.wi));
     double lightDensity = ds.pickProb * ds.ls.pdf;
     double w = mis && !ds.ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
     return m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity);
@@ -119,7 +119,7 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
             stack.toggle(hit.mesh);
             s.type = SurfaceScatter::Type::Pass;
             s.next = {hit.p, ray.d};
-            s.tMin = spawnTMin(hit, ray.d);
+            s.tMin = scene_.spawnTMin(hit, ray.d);
             s.crossed = true;
             return s;
         case SurfaceMaterial::Kind::Lambertian: {
@@ -130,7 +130,7 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
             if (dot(w, hit.ng) * dot(wo, hit.ng) <= 0) return s;  // shading normal sent it below the surface
             s.type = SurfaceScatter::Type::Diffuse;
             s.next = {hit.p, w};
-            s.tMin = spawnTMin(hit, w);
+            s.tMin = scene_.spawnTMin(hit, w);
             s.weight = m.albedo;  // f cos / pdf = (albedo/pi) cos / (cos/pi)
             return s;
         }
@@ -144,7 +144,7 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
                 Vec3 r = n * (2 * cosI) - wo;
                 s.type = SurfaceScatter::Type::Specular;
                 s.next = {hit.p, r};
-                s.tMin = spawnTMin(hit, r);
+                s.tMin = scene_.spawnTMin(hit, r);
                 return s;
             }
             double sin2T = (1 - cosI * cosI) / (eta * eta);
@@ -152,7 +152,7 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
             Vec3 t = normalize(-wo / eta + n * (cosI / eta - cosT));
             s.type = SurfaceScatter::Type::Specular;
             s.next = {hit.p, t};
-            s.tMin = spawnTMin(hit, t);
+            s.tMin = scene_.spawnTMin(hit, t);
             s.crossed = true;
             if (radianceMode) s.weight = Spectrum(1.0 / (eta * eta));
             stack.toggle(hit.mesh);
@@ -187,11 +187,31 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
 
 Renderer::~Renderer() = default;
 
+namespace {
+
+/// Caps TBB's parallelism at settings.threads (> 0) for as long as the returned object lives.
+std::unique_ptr<tbb::global_control> limitThreads(const RenderSettings& settings) {
+    if (settings.threads <= 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings.threads);
+}
+
+/// One camera sample of pixel (x, y): a jittered position in it and the integrator's radiance.
+/// false (and an empty result) when a numerical accident made the radiance non-finite or negative:
+/// such a sample must never reach a film.
+bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int y, Rng& rng, PathRadiance* L) {
+    double tMin, tMax;
+    Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
+    *L = integrator.Li(ray, tMin, tMax, rng);
+    if (L->beauty().isFinite() && L->beauty().minValue() >= 0) return true;
+    *L = PathRadiance();
+    return false;
+}
+
+}  // namespace
+
 bool Renderer::renderPass(const CancelCallback& cancel) {
     auto start = std::chrono::steady_clock::now();
-    std::unique_ptr<tbb::global_control> threads;
-    if (settings_.threads > 0)
-        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings_.threads);
+    auto threads = limitThreads(settings_);
     if (!integrator_->beginPass(pass_, stats_, cancel)) {
         stats_.cancelled = true;
         return false;
@@ -212,14 +232,10 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
                         Rng rng(hashKeys(x, y, settings_.seed), static_cast<uint64_t>(pass_));
                         rng.stratify(static_cast<uint32_t>(pass_), hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
-                        double tMin, tMax;
-                        Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
-                        PathRadiance L = integrator_->Li(ray, tMin, tMax, rng);
-                        // Never let a numerical accident reach the film: report and drop the sample.
-                        if (!L.beauty().isFinite() || L.beauty().minValue() < 0) {
+                        PathRadiance L;
+                        if (!cameraSample(*integrator_, camera, x, y, rng, &L)) {  // never on the film: dropped, and reported
                             static std::atomic<int> reported{0};
                             if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
-                            L = PathRadiance();
                         }
                         film_.add(x, y, L);
                         if (pass_ == 0) film_.setIds(x, y, pixelIds(camera, x, y));
@@ -243,9 +259,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
 bool Renderer::renderPreview(int block, Film& preview, const CancelCallback& cancel) const {
     if (block < 1 || preview.width() != settings_.width || preview.height() != settings_.height)
         throw std::invalid_argument("preview: block must be >= 1 and the film the render's size");
-    std::unique_ptr<tbb::global_control> threads;
-    if (settings_.threads > 0)
-        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, settings_.threads);
+    auto threads = limitThreads(settings_);
     preview.clear();
     std::unique_ptr<Integrator> pathTracer = makePathTracer(*scene_, settings_);
     Camera camera(scene_->desc().camera, settings_.width, settings_.height);
@@ -264,10 +278,8 @@ bool Renderer::renderPreview(int block, Film& preview, const CancelCallback& can
                 int x1 = std::min(settings_.width, x0 + block), y1 = std::min(settings_.height, y0 + block);
                 int cx = (x0 + x1 - 1) / 2, cy = (y0 + y1 - 1) / 2;
                 Rng rng(hashKeys(cx, cy, settings_.seed), previewStream);
-                double tMin, tMax;
-                Ray ray = camera.generateRay(cx + rng.uniform(), cy + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
-                PathRadiance L = pathTracer->Li(ray, tMin, tMax, rng);
-                if (!L.beauty().isFinite() || L.beauty().minValue() < 0) L = PathRadiance();
+                PathRadiance L;
+                cameraSample(*pathTracer, camera, cx, cy, rng, &L);  // a dropped sample leaves the block black
                 PixelIds ids = pixelIds(camera, cx, cy);
                 for (int y = y0; y < y1; ++y)
                     for (int x = x0; x < x1; ++x) {
@@ -295,7 +307,7 @@ PixelIds Renderer::pixelIds(const Camera& camera, int x, int y) const {
         // Straight on through the boundary, as PathRay::passBoundary does.
         ray = {hit.p, ray.d};
         if (!std::isinf(tMax)) tMax -= hit.t;
-        tMin = scene_->epsilon() / std::max(std::abs(dot(ray.d, hit.ng)), 0.1);
+        tMin = scene_->spawnTMin(hit, ray.d);
     }
     return boundary;
 }

@@ -93,15 +93,6 @@ protected:
     /// Distance at which a path inside a mesh medium with no surface ahead leaves the mesh's bounds
     /// (infinity when it is inside no mesh). Warns once per render: the mesh is not closed.
     double leakDistance(const MediumStack& stack, const Ray& ray) const;
-    /// Ray parameter from which a ray leaving `hit` along w may meet surfaces again: clear of the
-    /// surface by the scene epsilon (Embree intersects in single precision). Rays start exactly at
-    /// the hit point, so the medium behind a surface is tracked from the surface itself; offsetting
-    /// the origin instead skipped a layer of medium, which matters when the mean free path is
-    /// below the epsilon.
-    double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
-        return scene_.epsilon() / std::max(std::abs(dot(w, hit.ng)), 0.1);
-    }
-
     const Scene& scene_;
     RenderSettings settings_;
     TransmittanceSettings transmittance_;

@@ -136,6 +136,14 @@ public:
     double radius() const { return radius_; }
     /// Scale of the scene for ray offsets.
     double epsilon() const { return epsilon_; }
+    /// Ray parameter from which a ray leaving `hit` along w may meet surfaces again: clear of the
+    /// surface by the scene epsilon (Embree intersects in single precision). Rays start exactly at
+    /// the hit point, so the medium behind a surface is tracked from the surface itself; offsetting
+    /// the origin instead skipped a layer of medium, which matters when the mean free path is
+    /// below the epsilon.
+    double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
+        return epsilon_ / std::max(std::abs(dot(w, hit.ng)), 0.1);
+    }
 
 private:
     SceneDesc desc_;

@@ -114,11 +114,7 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     auto number = [this](TfToken const &key, double fallback, double lo, double hi) {
         VtValue v = GetRenderSetting(key);
         double x = fallback;
-        if (v.IsHolding<double>()) x = v.UncheckedGet<double>();
-        else if (v.IsHolding<float>()) x = v.UncheckedGet<float>();
-        else if (v.IsHolding<int>()) x = v.UncheckedGet<int>();
-        else if (v.IsHolding<int64_t>()) x = static_cast<double>(v.UncheckedGet<int64_t>());
-        else if (v.IsHolding<unsigned int>()) x = v.UncheckedGet<unsigned int>();
+        if (v.CanCast<double>()) x = v.Cast<double>().UncheckedGet<double>();  // Vt's numeric casts
         else if (!v.IsEmpty()) TF_WARN("hdVolPhoton: render setting %s has type %s; using %g", key.GetText(), v.GetTypeName().c_str(), fallback);
         if (!(x >= lo && x <= hi)) {
             double c = std::isnan(x) ? fallback : std::clamp(x, lo, hi);
