@@ -594,7 +594,8 @@ def plot(results, path, summary):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="the quick set (< 15 min on 2 cores)")
-    ap.add_argument("--scenes", default="", help="comma-separated scene names (default: all seven)")
+    ap.add_argument("--scenes", default="", help="comma-separated scene names (default: the quick set's seven, "
+                                                 "or all nine for the full set)")
     ap.add_argument("--no-mitsuba", action="store_true")
     ap.add_argument("--no-cycles", action="store_true")
     ap.add_argument("--cycles-references", action="store_true",
@@ -615,7 +616,7 @@ def main(argv=None) -> int:
         plot(summary["results"], os.path.join(args.out, "error_vs_time.png"), summary)
         return 0
     run = Run(args)
-    names = [n for n in args.scenes.split(",") if n] or [s.name for s in S.SCENES]
+    names = [n for n in args.scenes.split(",") if n] or (S.QUICK_DEFAULT if args.quick else [s.name for s in S.SCENES])
     for n in names:
         if n not in S.BY_NAME:
             ap.error("unknown scene %r (known: %s)" % (n, ", ".join(S.BY_NAME)))
