@@ -600,7 +600,7 @@ def test_phase_mapping_including_tabulated_and_mixture(tmp_path):
     """)
     md, diags = volphoton.schema.read_medium(stage.GetPrimAtPath("/mix"), Usd.TimeCode.Default())
     assert not diags
-    ph = usdscene.phase_to_core(md.phase)
+    ph = _core.build_phase(md.core.phase)
     # tabulated [2, 0]: p ~ (1 - cos)/... has mean cosine -1/3; HG mean cosine 0.8
     assert ph.mean_cosine() == pytest.approx(0.75 * 0.8 + 0.25 * (-1 / 3), abs=1e-3)
 
@@ -741,7 +741,7 @@ def test_render_settings_prim_and_priority(tmp_path):
     """)
     info = usdscene.read_render_settings(stage)
     assert info.prim_path == "/Render/rs" and info.resolution == (20, 10) and info.camera_path == "/cam2"
-    assert info.overrides == {"samples_per_pixel": 3, "max_depth": 7, "integrator": "photonMap"}
+    assert info.overrides == {"samplesPerPixel": 3, "maxDepth": 7, "integrator": "photonMap"}
     assert "/Render/rs.volphoton:bogus: unknown render setting" in diag_text(info.diagnostics)
     stats = tmp_path / "s.json"
     r = run_cli("render", path, "-o", tmp_path / "o.exr", "--quiet", "--stats", stats)

@@ -78,9 +78,7 @@ def load_usd(path, width, height):
     sc = usdscene.translate(stage, Usd.TimeCode.Default(), width, height, info.camera_path, info.conform_policy)
     problems = [d for d in sc.diagnostics if d.severity != "info"]
     assert not problems, "\n".join(map(str, problems))
-    s = _core.RenderSettings()
-    for k, v in info.overrides.items():
-        setattr(s, k, v)
+    s = info.settings
     s.width, s.height = width, height
     return _core.Scene(sc.desc), s, sc
 

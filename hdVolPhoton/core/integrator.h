@@ -31,6 +31,8 @@
 // | photonMapBudgetBytes| size_t | 1 GiB      | bytes        | photonMap: memory cap of one pass's photon map;   |
 // |                     |        |            |              | beyond it photons are thinned at random, their    |
 // |                     |        |            |              | power scaled up (unbiased), and the stats say so  |
+// | maxGridVoxels       | uint64 | 2^30       | voxels       | VDB grids with more active voxels are refused     |
+// |                     |        |            |              | (warned; the volume is skipped); 0: no cap        |
 // | domeVisibleToCamera | bool   | true       |              | false: camera rays that escape (straight through  |
 // |                     |        |            |              | media and index-matched boundaries) see black and |
 // |                     |        |            |              | alpha 0; the dome still lights the scene (Hydra's |
@@ -80,6 +82,8 @@ struct RenderSettings {
     double transmittanceCutoff = 0;
     size_t photonMapBudgetBytes = size_t(1) << 30;
     bool domeVisibleToCamera = true;
+    /// Grid-size cap applied when front ends load VDB grids (GridMediumDesc::maxActiveVoxels); 0 = none.
+    std::uint64_t maxGridVoxels = std::uint64_t(1) << 30;
 };
 
 /// What ran, what was skipped and why, and how long each part took.

@@ -15,6 +15,7 @@ HdDirtyBits HdVolPhotonField::GetInitialDirtyBitsMask() const { return DirtyTran
 void HdVolPhotonField::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *renderParam, HdDirtyBits *dirtyBits) {
     SdfPath const &id = GetId();
     HdVolPhoton_FieldRecord rec;
+    rec.primPath = id.GetString();
     VtValue path = sceneDelegate->Get(id, HdFieldTokens->filePath);
     if (path.IsHolding<SdfAssetPath>()) {
         SdfAssetPath const &asset = path.UncheckedGet<SdfAssetPath>();

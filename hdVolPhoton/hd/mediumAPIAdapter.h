@@ -11,10 +11,11 @@ PXR_NAMESPACE_OPEN_SCOPE
 ///
 /// With UsdImaging's scene-index path, attributes an adapter does not publish never reach the
 /// render delegate. This API-schema adapter publishes every `volphoton:*` attribute of a prim with
-/// VolPhotonMediumAPI as a constant primvar of the same name, which HdSceneDelegate::Get() finds
-/// (HdSceneIndexAdapterSceneDelegate looks keys up among primvars). With the legacy
-/// UsdImagingDelegate the same Get() reaches the attribute directly, so the delegate reads media
-/// the same way on both paths.
+/// VolPhotonMediumAPI that has a value as a constant primvar of the same name, plus the applied lobe
+/// instances, the stage's up axis and the authored names (hd/mediumParams.h), which
+/// HdVolPhoton_ReadMedium collects into the translation layer's record. With the legacy
+/// UsdImagingDelegate the delegate reads the UsdPrim itself, so both paths hand the translation
+/// layer the same record.
 class HdVolPhotonMediumAPIAdapter final : public UsdImagingAPISchemaAdapter
 {
 public:

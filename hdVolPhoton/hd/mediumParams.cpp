@@ -1,152 +1,158 @@
 #include "hd/mediumParams.h"
 
-#include "core/presets.h"
-
+#include "pxr/base/gf/half.h"
+#include "pxr/base/gf/vec3d.h"
+#include "pxr/base/gf/vec3f.h"
+#include "pxr/base/gf/vec3h.h"
 #include "pxr/base/tf/diagnostic.h"
+#include "pxr/base/tf/stringUtils.h"
+#include "pxr/base/vt/array.h"
 #include "pxr/imaging/hd/sceneDelegate.h"
-
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include "pxr/usd/sdf/assetPath.h"
+#include "pxr/usd/usd/attribute.h"
+#include "pxr/usd/usd/schemaRegistry.h"
+#include "pxr/usd/usdGeom/gprim.h"
+#include "pxr/usd/usdGeom/metrics.h"
+#include "pxr/usd/usdVol/volume.h"
+#include "pxr/usdImaging/usdImaging/delegate.h"
+#include "pxr/usdImaging/usdImaging/primAdapter.h"
 
 PXR_NAMESPACE_OPEN_SCOPE
 
+using namespace volphoton;
+using volphoton::translate::AttrValue;
+
 namespace {
 
-template <typename T>
-bool _Get(HdSceneDelegate *sd, SdfPath const &id, char const *name, T *out) {
-    VtValue v = sd->Get(id, TfToken(name));
-    if (v.IsHolding<T>()) {
-        *out = v.UncheckedGet<T>();
-        return true;
-    }
-    // Attributes authored with a neighbouring type (double vs float) still count.
-    if (!v.IsEmpty() && v.CanCast<T>()) {
-        *out = v.Cast<T>().template UncheckedGet<T>();
-        return true;
-    }
-    return false;
+template <class A>
+std::vector<double> _ToList(A const &a) {
+    return std::vector<double>(a.begin(), a.end());
 }
 
-float _Clamp(SdfPath const &id, char const *name, float v, float lo, float hi, float fallback) {
-    if (!std::isfinite(v)) {
-        TF_WARN("%s.%s: %g is not finite; using %g", id.GetText(), name, v, fallback);
-        return fallback;
-    }
-    if (v < lo || v > hi) {
-        float c = std::min(hi, std::max(lo, v));
-        TF_WARN("%s.%s: %g is outside [%g, %g]; clamped to %g", id.GetText(), name, v, lo, hi, c);
-        return c;
-    }
-    return v;
-}
+/// UsdImagingPrimAdapter's protected _GetPrim/_GetStage reach the legacy delegate's UsdPrims; this
+/// adapter is never registered or populated, it only borrows that access for one read.
+class _PrimAccess final : public UsdImagingPrimAdapter
+{
+public:
+    UsdPrim Prim(SdfPath const &usdPath) const { return _GetPrim(usdPath); }
+    SdfPath Populate(UsdPrim const &, UsdImagingIndexProxy *, UsdImagingInstancerContext const *) override { return {}; }
+    void TrackVariability(UsdPrim const &, SdfPath const &, HdDirtyBits *, UsdImagingInstancerContext const *) const override {}
+    void UpdateForTime(UsdPrim const &, SdfPath const &, UsdTimeCode, HdDirtyBits,
+                       UsdImagingInstancerContext const *) const override {}
+    HdDirtyBits ProcessPropertyChange(UsdPrim const &, SdfPath const &, TfToken const &) override { return 0; }
+    void MarkDirty(UsdPrim const &, SdfPath const &, HdDirtyBits, UsdImagingIndexProxy *) override {}
 
-GfVec3f _ClampColor(SdfPath const &id, char const *name, GfVec3f v, float lo, float hi, GfVec3f fallback) {
-    for (int i = 0; i < 3; ++i)
-        v[i] = _Clamp(id, name, v[i], lo, hi, fallback[i]);
-    return v;
-}
-
-volphoton::Spectrum _Spectrum(GfVec3f const &v) { return {v[0], v[1], v[2]}; }
+protected:
+    void _RemovePrim(SdfPath const &, UsdImagingIndexProxy *) override {}
+};
 
 }  // namespace
 
-std::optional<HdVolPhoton_MediumParams> HdVolPhoton_ReadMediumParams(HdSceneDelegate *sd, SdfPath const &id) {
-    HdVolPhoton_MediumParams p;
-    // The API's attributes all have fallbacks, so density is present exactly when the API is applied.
-    if (!_Get(sd, id, "volphoton:density", &p.density)) return std::nullopt;
-    p.density = _Clamp(id, "volphoton:density", p.density, 0.0f, 1e30f, 1.0f);
-    if (_Get(sd, id, "volphoton:albedo", &p.albedo))
-        p.albedo = _ClampColor(id, "volphoton:albedo", p.albedo, 0.0f, 1.0f, GfVec3f(0.8f));
-    if (_Get(sd, id, "volphoton:extinctionColor", &p.extinctionColor))
-        p.extinctionColor = _ClampColor(id, "volphoton:extinctionColor", p.extinctionColor, 0.0f, 1e30f, GfVec3f(1.0f));
-    if (_Get(sd, id, "volphoton:emission", &p.emission))
-        p.emission = _ClampColor(id, "volphoton:emission", p.emission, 0.0f, 1e30f, GfVec3f(0.0f));
-    _Get(sd, id, "volphoton:emissionScale", &p.emissionScale);
-    _Get(sd, id, "volphoton:temperatureScale", &p.temperatureScale);
-    _Get(sd, id, "volphoton:phase", &p.phase);
-    if (_Get(sd, id, "volphoton:phase:g", &p.g))
-        p.g = _Clamp(id, "volphoton:phase:g", p.g, -0.99999f, 0.99999f, 0.0f);
-    float k;
-    if (_Get(sd, id, "volphoton:phase:k", &k))
-        p.k = _Clamp(id, "volphoton:phase:k", k, -0.99999f, 0.99999f, 0.0f);
-    if (_Get(sd, id, "volphoton:phase:x", &p.x))
-        p.x = _Clamp(id, "volphoton:phase:x", p.x, -1.0f, 1.0f, 0.0f);
-    _Get(sd, id, "volphoton:phase:table", &p.table);
-    _Get(sd, id, "volphoton:densityMode", &p.densityMode);
-    _Get(sd, id, "volphoton:exponential:a", &p.expA);
-    p.expA = _Clamp(id, "volphoton:exponential:a", p.expA, 0.0f, 1e30f, 1.0f);
-    _Get(sd, id, "volphoton:exponential:b", &p.expB);
-    p.expB = _Clamp(id, "volphoton:exponential:b", p.expB, 0.0f, 1e30f, 1.0f);
-    GfVec3f up;
-    // The attribute has no fallback. The scene-index path of OpenUSD 24.08 reports it unauthored as
-    // (0, 0, 0), so a zero vector means "unauthored" (+Y) without a warning on either path.
-    if (_Get(sd, id, "volphoton:exponential:up", &up) && up != GfVec3f(0.0f)) {
-        if (up.GetLength() > 0 && std::isfinite(up.GetLength())) p.expUp = up;
-        else TF_WARN("%s.volphoton:exponential:up: a non-finite vector; using +Y", id.GetText());
+AttrValue HdVolPhoton_ToAttrValue(VtValue const &v) {
+    if (v.IsHolding<bool>()) return v.UncheckedGet<bool>();
+    if (v.IsHolding<int>()) return int64_t(v.UncheckedGet<int>());
+    if (v.IsHolding<unsigned int>()) return int64_t(v.UncheckedGet<unsigned int>());
+    if (v.IsHolding<int64_t>()) return v.UncheckedGet<int64_t>();
+    if (v.IsHolding<uint64_t>()) return int64_t(v.UncheckedGet<uint64_t>());
+    if (v.IsHolding<float>()) return double(v.UncheckedGet<float>());
+    if (v.IsHolding<double>()) return v.UncheckedGet<double>();
+    if (v.IsHolding<GfHalf>()) return double(v.UncheckedGet<GfHalf>());
+    if (v.IsHolding<GfVec3f>()) {
+        GfVec3f const &x = v.UncheckedGet<GfVec3f>();
+        return Vec3(x[0], x[1], x[2]);
     }
-    _Get(sd, id, "volphoton:exponential:origin", &p.expOrigin);
-    if (_Get(sd, id, "volphoton:ior", &p.ior)) p.ior = _Clamp(id, "volphoton:ior", p.ior, 1.0f, 10.0f, 1.0f);
-    GfVec3f lo, hi;
-    if (_Get(sd, id, "volphoton:bounds:min", &lo) && _Get(sd, id, "volphoton:bounds:max", &hi)) {
-        if (lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]) p.bounds = std::make_pair(lo, hi);
-        else TF_WARN("%s.volphoton:bounds:min: bounds:min is not below bounds:max; ignored", id.GetText());
+    if (v.IsHolding<GfVec3d>()) {
+        GfVec3d const &x = v.UncheckedGet<GfVec3d>();
+        return Vec3(x[0], x[1], x[2]);
     }
-    _Get(sd, id, "volphoton:preset", &p.preset);
-    if (!p.preset.IsEmpty() && !volphoton::findSubsurfacePreset(p.preset.GetString())) {
-        TF_WARN("%s.volphoton:preset: unknown preset '%s' (known: %s); using density, albedo and extinctionColor",
-                id.GetText(), p.preset.GetText(), volphoton::subsurfacePresetNames().c_str());
-        p.preset = TfToken();
+    if (v.IsHolding<GfVec3h>()) {
+        GfVec3h const &x = v.UncheckedGet<GfVec3h>();
+        return Vec3(x[0], x[1], x[2]);
     }
-    if (_Get(sd, id, "volphoton:sceneUnitsPerMm", &p.sceneUnitsPerMm))
-        p.sceneUnitsPerMm = _Clamp(id, "volphoton:sceneUnitsPerMm", p.sceneUnitsPerMm, 1e-30f, 1e30f, 1.0f);
-    return p;
+    if (v.IsHolding<TfToken>()) return v.UncheckedGet<TfToken>().GetString();
+    if (v.IsHolding<std::string>()) return v.UncheckedGet<std::string>();
+    if (v.IsHolding<SdfAssetPath>()) {
+        SdfAssetPath const &a = v.UncheckedGet<SdfAssetPath>();
+        return a.GetResolvedPath().empty() ? a.GetAssetPath() : a.GetResolvedPath();
+    }
+    if (v.IsHolding<VtFloatArray>()) return _ToList(v.UncheckedGet<VtFloatArray>());
+    if (v.IsHolding<VtDoubleArray>()) return _ToList(v.UncheckedGet<VtDoubleArray>());
+    if (v.IsHolding<VtIntArray>()) return _ToList(v.UncheckedGet<VtIntArray>());
+    if (v.IsHolding<VtHalfArray>()) return _ToList(v.UncheckedGet<VtHalfArray>());
+    return translate::Unusable{v.GetTypeName()};
 }
 
-volphoton::PhasePtr HdVolPhoton_BuildPhase(HdVolPhoton_MediumParams const &p, SdfPath const &id) {
-    using namespace volphoton;
-    std::string kind = p.phase.GetString();
-    try {
-        if (kind == "isotropic") return makeIsotropicPhase();
-        if (kind == "linear") return makeLinearPhase(p.x);
-        if (kind == "rayleigh") return makeRayleighPhase();
-        if (kind == "lambertianSphere") return makeLambertianSpherePhase();
-        if (kind == "henyeyGreenstein") return makeHenyeyGreensteinPhase(p.g);
-        if (kind == "schlick") return makeSchlickPhase(p.k ? *p.k : schlickKFromG(p.g));
-        if (kind == "tabulated") return makeTabulatedPhase(std::vector<double>(p.table.begin(), p.table.end()));
-        if (kind == "mixture") {
-            // XXX: the lobes of VolPhotonPhaseLobeAPI are read by the usd-core front end only.
-            TF_WARN("%s.volphoton:phase: mixtures are not read by the Hydra delegate yet; using "
-                    "henyeyGreenstein(g)", id.GetText());
-            return makeHenyeyGreensteinPhase(p.g);
-        }
-        TF_WARN("%s.volphoton:phase: unknown phase '%s'; using isotropic", id.GetText(), kind.c_str());
-    } catch (std::exception const &e) {
-        TF_WARN("%s.volphoton:phase: %s; using isotropic", id.GetText(), e.what());
-    }
-    return makeIsotropicPhase();
+UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sd, SdfPath const &id, UsdTimeCode *time) {
+    auto *usd = dynamic_cast<UsdImagingDelegate *>(sd);
+    if (!usd || id.IsEmpty()) return UsdPrim();
+    _PrimAccess access;
+    access.SetDelegate(usd);
+    if (time) *time = usd->GetTime();
+    return access.Prim(usd->GetScenePrimPath(id, 0, nullptr));
 }
 
-volphoton::MediumCoefficients HdVolPhoton_BuildCoefficients(HdVolPhoton_MediumParams const &p, SdfPath const &id) {
-    volphoton::PhasePtr phase = HdVolPhoton_BuildPhase(p, id);
-    volphoton::Spectrum extinction = _Spectrum(p.extinctionColor), albedo = _Spectrum(p.albedo);
-    double density = p.density;
-    if (volphoton::SubsurfacePreset const *preset = p.preset.IsEmpty() ? nullptr : volphoton::findSubsurfacePreset(p.preset.GetString())) {
-        // The measured material, as the usd-core front end maps it (volphoton/presets.py).
-        try {
-            volphoton::PresetCoefficients c = volphoton::presetCoefficients(*preset, p.sceneUnitsPerMm, phase->meanCosine());
-            volphoton::Spectrum sigma_t = c.sigma_s + c.sigma_a;
-            density = sigma_t.maxValue();
-            for (int i = 0; i < 3; ++i) {
-                extinction[i] = density > 0 ? sigma_t[i] / density : 0.0;
-                albedo[i] = sigma_t[i] > 0 ? c.sigma_s[i] / sigma_t[i] : 0.0;
+HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTimeCode time) {
+    HdVolPhoton_MediumInput in;
+    in.record.primPath = prim.GetPath().GetString();
+    for (UsdAttribute const &attr : prim.GetAttributes()) {
+        std::string const &name = attr.GetName().GetString();
+        if (!TfStringStartsWith(name, "volphoton:")) continue;
+        VtValue v;
+        if (!attr.Get(&v, time) || v.IsEmpty()) continue;
+        in.record.values[name] = HdVolPhoton_ToAttrValue(v);
+        if (attr.HasAuthoredValue()) in.record.authored.insert(name);
+    }
+    translate::MediumContext &c = in.context;
+    c.isVolume = prim.IsA<UsdVolVolume>();
+    c.isGprim = prim.IsA<UsdGeomGprim>();
+    c.typeName = prim.GetTypeName().GetString();
+    static std::string const lobePrefix = "VolPhotonPhaseLobeAPI:";
+    for (TfToken const &s : prim.GetAppliedSchemas()) {
+        if (s == "VolPhotonMediumAPI") c.hasApi = true;
+        else if (TfStringStartsWith(s.GetString(), lobePrefix)) c.lobeNames.push_back(s.GetString().substr(lobePrefix.size()));
+    }
+    c.schemaRegistered = UsdSchemaRegistry::GetInstance().FindAppliedAPIPrimDefinition(TfToken("VolPhotonMediumAPI")) != nullptr;
+    c.stageUp = UsdGeomGetStageUpAxis(prim.GetStage()) == UsdGeomTokens->z ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+    return in;
+}
+
+std::optional<translate::MediumParams> HdVolPhoton_ReadMedium(HdSceneDelegate *sd, SdfPath const &id, bool isVolume,
+                                                              bool hasDensityField) {
+    UsdTimeCode time = UsdTimeCode::Default();
+    HdVolPhoton_MediumInput in;
+    if (UsdPrim prim = HdVolPhoton_FindUsdPrim(sd, id, &time)) {
+        in = HdVolPhoton_ReadMediumInput(prim, time);
+    } else {
+        // Scene-index path: the primvars of HdVolPhotonMediumAPIAdapter (present when the API is applied).
+        in.record.primPath = id.GetString();
+        in.context.isVolume = isVolume;
+        in.context.isGprim = !isVolume;
+        for (HdPrimvarDescriptor const &pv : sd->GetPrimvarDescriptors(id, HdInterpolationConstant)) {
+            std::string const &name = pv.name.GetString();
+            if (!TfStringStartsWith(name, "volphoton:")) continue;
+            VtValue v = sd->Get(id, pv.name);
+            if (name == HDVOLPHOTON_MEDIUM_LOBES && v.IsHolding<VtTokenArray>()) {
+                for (TfToken const &t : v.UncheckedGet<VtTokenArray>()) in.context.lobeNames.push_back(t.GetString());
+            } else if (name == HDVOLPHOTON_MEDIUM_STAGE_UP && v.IsHolding<GfVec3d>()) {
+                GfVec3d const &u = v.UncheckedGet<GfVec3d>();
+                in.context.stageUp = Vec3(u[0], u[1], u[2]);
+            } else if (name == HDVOLPHOTON_MEDIUM_AUTHORED && v.IsHolding<VtTokenArray>()) {
+                in.context.hasApi = true;
+                for (TfToken const &t : v.UncheckedGet<VtTokenArray>()) in.record.authored.insert(t.GetString());
+            } else if (!v.IsEmpty()) {
+                in.record.values[name] = HdVolPhoton_ToAttrValue(v);
             }
-        } catch (std::exception const &e) {
-            TF_WARN("%s.volphoton:preset: %s; using density, albedo and extinctionColor", id.GetText(), e.what());
         }
     }
-    return volphoton::MediumCoefficients::fromAlbedo(density, extinction, albedo, _Spectrum(p.emission) * p.emissionScale,
-                                                     phase);
+    in.context.hasDensityField = hasDensityField;
+    translate::Diagnostics diagnostics;
+    std::optional<translate::MediumParams> params = translate::readMedium(in.record, in.context, diagnostics);
+    HdVolPhoton_Report(diagnostics);
+    return params;
+}
+
+void HdVolPhoton_Report(translate::Diagnostics const &diagnostics) {
+    for (translate::Diagnostic const &d : diagnostics.list()) TF_WARN("hdVolPhoton: %s", d.text().c_str());
 }
 
 PXR_NAMESPACE_CLOSE_SCOPE

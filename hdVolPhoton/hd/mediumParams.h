@@ -1,16 +1,22 @@
-// hdVolPhoton: VolPhotonMediumAPI attributes as the delegate reads them from a scene delegate, and
-// their translation into core media. The same names, defaults and rules as schemas/README.md and
-// the usd-core front end (hdVolPhoton/python/volphoton/schema.py).
+// hdVolPhoton: what the delegate hands the translation layer (core/translate/medium.h) for a prim
+// with VolPhotonMediumAPI or a Volume: its volphoton:* attributes, the applied lobe instances, the
+// stage's up axis. The rules themselves are the core's, the same the usd-core front end applies.
+//
+// Where the values come from:
+//  * the legacy scene delegate (UsdImagingDelegate, OpenUSD 24.08's default for usdrecord/usdview):
+//    the UsdPrim itself (HdVolPhoton_FindUsdPrim), read exactly as the usd-core front end reads it;
+//  * the scene-index path: the primvars HdVolPhotonMediumAPIAdapter publishes (every volphoton:*
+//    attribute, plus volphoton:__lobes, volphoton:__stageUp and volphoton:__authored).
 #ifndef HDVOLPHOTON_MEDIUM_PARAMS_H
 #define HDVOLPHOTON_MEDIUM_PARAMS_H
 
 #include "pxr/pxr.h"
-#include "pxr/base/gf/vec3f.h"
-#include "pxr/base/tf/token.h"
-#include "pxr/base/vt/array.h"
+#include "pxr/base/vt/value.h"
 #include "pxr/usd/sdf/path.h"
+#include "pxr/usd/usd/prim.h"
+#include "pxr/usd/usd/timeCode.h"
 
-#include "core/homogeneousMedium.h"
+#include "core/translate/medium.h"
 
 #include <optional>
 
@@ -18,42 +24,33 @@ PXR_NAMESPACE_OPEN_SCOPE
 
 class HdSceneDelegate;
 
-/// The medium schema's values for one prim (defaults as in the schema).
-struct HdVolPhoton_MediumParams {
-    float density = 1.0f;
-    GfVec3f albedo{0.8f, 0.8f, 0.8f};
-    GfVec3f extinctionColor{1.0f, 1.0f, 1.0f};
-    GfVec3f emission{0.0f, 0.0f, 0.0f};
-    float emissionScale = 1.0f;
-    float temperatureScale = 1.0f;
-    TfToken phase{"henyeyGreenstein"};
-    float g = 0.0f;
-    std::optional<float> k;  ///< Schlick; derived from g when not authored
-    float x = 0.0f;
-    VtFloatArray table;
-    TfToken densityMode;     ///< empty: field when a density field is bound, else constant
-    float expA = 1.0f, expB = 1.0f;
-    std::optional<GfVec3f> expUp;  ///< default: +Y (Hydra does not carry the stage's up axis)
-    GfVec3f expOrigin{0.0f, 0.0f, 0.0f};
-    float ior = 1.0f;
-    std::optional<std::pair<GfVec3f, GfVec3f>> bounds;
-    TfToken preset;              ///< measured material (core/presets.h); replaces density, albedo, extinctionColor
-    float sceneUnitsPerMm = 1.0f;
+/// The extra primvars the scene-index adapter publishes beside the attributes.
+#define HDVOLPHOTON_MEDIUM_LOBES "volphoton:__lobes"
+#define HDVOLPHOTON_MEDIUM_STAGE_UP "volphoton:__stageUp"
+#define HDVOLPHOTON_MEDIUM_AUTHORED "volphoton:__authored"
+
+/// A Vt value as the translation layer takes it (TfToken, std::string and resolved asset paths as
+/// text; float/double/half as double; 3-vectors as Vec3; numeric arrays as lists).
+volphoton::translate::AttrValue HdVolPhoton_ToAttrValue(VtValue const &value);
+
+/// Record and context of a prim, read off the UsdPrim (what both UsdImaging paths start from).
+struct HdVolPhoton_MediumInput {
+    volphoton::translate::AttributeRecord record;
+    volphoton::translate::MediumContext context;
 };
+HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTimeCode time);
 
-/// Reads the `volphoton:*` attributes of prim `id` through HdSceneDelegate::Get(), which reaches
-/// them in both UsdImaging paths: the scene delegate's attribute fallback and, with scene indices,
-/// the primvars the VolPhotonMediumAPI adapter publishes. Returns nullopt when the prim does not
-/// carry the API. Out-of-range values are clamped with a TF_WARN naming prim and attribute.
-std::optional<HdVolPhoton_MediumParams> HdVolPhoton_ReadMediumParams(HdSceneDelegate *sceneDelegate,
-                                                                     SdfPath const &id);
+/// The validated medium of rprim `id` (a Volume when isVolume, else a Gprim), or nullopt when it is
+/// not a medium. Diagnostics become TF_WARNs naming prim and attribute.
+std::optional<volphoton::translate::MediumParams> HdVolPhoton_ReadMedium(HdSceneDelegate *sceneDelegate, SdfPath const &id,
+                                                                         bool isVolume, bool hasDensityField);
 
-/// Phase function of the parameters; unknown tokens warn and fall back to isotropic.
-volphoton::PhasePtr HdVolPhoton_BuildPhase(HdVolPhoton_MediumParams const &params, SdfPath const &id);
+/// The UsdPrim behind rprim/sprim `id` when the scene delegate is the legacy UsdImagingDelegate
+/// (invalid otherwise), and the time it renders.
+UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sceneDelegate, SdfPath const &id, UsdTimeCode *time = nullptr);
 
-/// sigma_t = density * extinctionColor, sigma_s = albedo * sigma_t, emission, phase.
-volphoton::MediumCoefficients HdVolPhoton_BuildCoefficients(HdVolPhoton_MediumParams const &params,
-                                                            SdfPath const &id);
+/// Sends translation diagnostics to the Tf diagnostic system ("hdVolPhoton: error: /prim.attr: ...").
+void HdVolPhoton_Report(volphoton::translate::Diagnostics const &diagnostics);
 
 PXR_NAMESPACE_CLOSE_SCOPE
 

@@ -7,8 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/diagnostics.h"
+#include "core/translate/settings.h"
+#include "hd/mediumParams.h"
 #include "hd/field.h"
 #include "hd/instancer.h"
 #include "hd/light.h"
@@ -65,26 +68,22 @@ void HdVolPhotonRenderDelegate::_Initialize() {
     });
     _resourceRegistry = std::make_shared<HdResourceRegistry>();
     _renderParam = std::make_unique<HdVolPhotonRenderParam>(&_renderThread, &_sceneVersion);
-    volphoton::RenderSettings d;
-    auto add = [&](char const *name, TfToken const &key, VtValue const &value) {
-        _settingDescriptors.push_back({name, key, value});
-    };
-    add("Integrator (pathTracer, photonMap)", HdVolPhotonRenderSettingsTokens->integrator, VtValue(HdVolPhotonRenderSettingsTokens->pathTracer));
-    add("Samples per pixel", HdRenderSettingsTokens->convergedSamplesPerPixel, VtValue(d.samplesPerPixel));
-    add("Thread limit (0: all cores)", HdRenderSettingsTokens->threadLimit, VtValue(d.threads));
-    add("Max depth", HdVolPhotonRenderSettingsTokens->maxDepth, VtValue(d.maxDepth));
-    add("Photons per pass", HdVolPhotonRenderSettingsTokens->photonsPerPass, VtValue(d.photonsPerPass));
-    add("Initial photon radius (0: auto)", HdVolPhotonRenderSettingsTokens->initialRadius, VtValue(static_cast<float>(d.initialRadius)));
-    add("Single scattering pass", HdVolPhotonRenderSettingsTokens->singleScattering, VtValue(d.singleScattering));
-    add("Multiple scattering pass", HdVolPhotonRenderSettingsTokens->multipleScattering, VtValue(d.multipleScattering));
-    add("Seed", HdVolPhotonRenderSettingsTokens->seed, VtValue(static_cast<int>(d.seed)));
-    add("Russian roulette depth", HdVolPhotonRenderSettingsTokens->rouletteDepth, VtValue(d.rouletteDepth));
-    add("Stratified dimensions (0: independent)", HdVolPhotonRenderSettingsTokens->stratifiedDims, VtValue(d.stratifiedDims));
-    add("Photon radius reduction (alpha)", HdVolPhotonRenderSettingsTokens->radiusAlpha, VtValue(static_cast<float>(d.radiusAlpha)));
-    add("Photon radius cap (mean free paths)", HdVolPhotonRenderSettingsTokens->photonRadiusMfp, VtValue(static_cast<float>(d.photonRadiusMfp)));
-    add("March step (0: auto)", HdVolPhotonRenderSettingsTokens->marchStep, VtValue(static_cast<float>(d.marchStep)));
-    add("Multiple-scattering threshold", HdVolPhotonRenderSettingsTokens->multipleThreshold, VtValue(static_cast<float>(d.multipleThreshold)));
-    add("Transmittance cut-off (biased)", HdVolPhotonRenderSettingsTokens->transmittanceCutoff, VtValue(static_cast<float>(d.transmittanceCutoff)));
+    // One descriptor per entry of the core's settings table (core/translate/settings.h), keyed by
+    // its Hydra key (HdRenderSettingsTokens where Hydra has one). Choices are strings, which
+    // usdview's settings dialog shows as a text field.
+    for (volphoton::translate::SettingInfo const &info : volphoton::translate::renderSettingsTable()) {
+        volphoton::translate::AttrValue def = info.defaultValue();
+        VtValue value;
+        switch (info.type) {
+        case volphoton::translate::SettingType::Bool: value = VtValue(std::get<bool>(def)); break;
+        case volphoton::translate::SettingType::Int:
+            value = VtValue(static_cast<int>(std::min<int64_t>(std::get<int64_t>(def), std::numeric_limits<int>::max())));
+            break;
+        case volphoton::translate::SettingType::Double: value = VtValue(static_cast<float>(std::get<double>(def))); break;
+        case volphoton::translate::SettingType::Choice: value = VtValue(std::get<std::string>(def)); break;
+        }
+        _settingDescriptors.push_back({info.label, TfToken(info.hydraKey), value});
+    }
     _PopulateDefaultSettings(_settingDescriptors);
     _renderThread.SetRenderCallback([this]() { _renderer.Render(&_renderThread); });
     _renderThread.StartThread();
@@ -97,40 +96,17 @@ HdVolPhotonRenderDelegate::~HdVolPhotonRenderDelegate() {
 
 volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     volphoton::RenderSettings s;
-    TfToken integrator = GetRenderSetting<TfToken>(HdVolPhotonRenderSettingsTokens->integrator, HdVolPhotonRenderSettingsTokens->pathTracer);
-    s.integrator = integrator == HdVolPhotonRenderSettingsTokens->photonMap ? volphoton::RenderSettings::Integrator::PhotonMap
-                                                                            : volphoton::RenderSettings::Integrator::PathTracer;
-    s.samplesPerPixel = std::max(1, GetRenderSetting<int>(HdRenderSettingsTokens->convergedSamplesPerPixel, s.samplesPerPixel));
-    s.threads = std::max(0, GetRenderSetting<int>(HdRenderSettingsTokens->threadLimit, s.threads));
-    s.maxDepth = std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->maxDepth, s.maxDepth));
-    s.photonsPerPass = std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->photonsPerPass, s.photonsPerPass));
-    s.initialRadius = std::max(0.0f, GetRenderSetting<float>(HdVolPhotonRenderSettingsTokens->initialRadius, 0.0f));
-    s.singleScattering = GetRenderSetting<bool>(HdVolPhotonRenderSettingsTokens->singleScattering, true);
-    s.multipleScattering = GetRenderSetting<bool>(HdVolPhotonRenderSettingsTokens->multipleScattering, true);
+    // Every table setting, whatever numeric type it arrived as (descriptors, usdview's dialog, a
+    // RenderSettings prim), validated by the same rules as the usd-core front end's.
+    volphoton::translate::Diagnostics diagnostics;
+    for (volphoton::translate::SettingInfo const &info : volphoton::translate::renderSettingsTable()) {
+        VtValue v = GetRenderSetting(TfToken(info.hydraKey));
+        if (v.IsEmpty()) continue;
+        volphoton::translate::applySetting(s, info.name, HdVolPhoton_ToAttrValue(v), diagnostics, "render setting");
+    }
+    HdVolPhoton_Report(diagnostics);
     // usdrecord hides domes from the camera unless --enableDomeLightVisibility; usdview shows them.
     s.domeVisibleToCamera = GetRenderSetting<bool>(HdRenderSettingsTokens->domeLightCameraVisibility, true);
-    s.seed = static_cast<uint64_t>(std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->seed, 0)));
-    // The numeric settings below come from RenderSettings prims as whatever type was authored.
-    auto number = [this](TfToken const &key, double fallback, double lo, double hi) {
-        VtValue v = GetRenderSetting(key);
-        double x = fallback;
-        if (v.CanCast<double>()) x = v.Cast<double>().UncheckedGet<double>();  // Vt's numeric casts
-        else if (!v.IsEmpty()) TF_WARN("hdVolPhoton: render setting %s has type %s; using %g", key.GetText(), v.GetTypeName().c_str(), fallback);
-        if (!(x >= lo && x <= hi)) {
-            double c = std::isnan(x) ? fallback : std::clamp(x, lo, hi);
-            TF_WARN("hdVolPhoton: render setting %s = %g is outside [%g, %g]; using %g", key.GetText(), x, lo, hi, c);
-            x = c;
-        }
-        return x;
-    };
-    constexpr double Big = 1e9;
-    s.rouletteDepth = static_cast<int>(number(HdVolPhotonRenderSettingsTokens->rouletteDepth, s.rouletteDepth, 0, Big));
-    s.stratifiedDims = static_cast<int>(number(HdVolPhotonRenderSettingsTokens->stratifiedDims, s.stratifiedDims, 0, 4096));
-    s.radiusAlpha = number(HdVolPhotonRenderSettingsTokens->radiusAlpha, s.radiusAlpha, 1e-6, 1);
-    s.photonRadiusMfp = number(HdVolPhotonRenderSettingsTokens->photonRadiusMfp, s.photonRadiusMfp, 0, Big);
-    s.marchStep = number(HdVolPhotonRenderSettingsTokens->marchStep, s.marchStep, 0, Big);
-    s.multipleThreshold = number(HdVolPhotonRenderSettingsTokens->multipleThreshold, s.multipleThreshold, 0, Big);
-    s.transmittanceCutoff = number(HdVolPhotonRenderSettingsTokens->transmittanceCutoff, s.transmittanceCutoff, 0, 1);
     return s;
 }
 

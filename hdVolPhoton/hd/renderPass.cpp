@@ -76,14 +76,14 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
     cam.farClip = clip.GetMax() > clip.GetMin() ? clip.GetMax() : volphoton::Infinity;
 
     auto *param = static_cast<HdVolPhotonRenderParam *>(_delegate->GetRenderParam());
+    volphoton::RenderSettings settings = _delegate->GetCoreSettings();
     std::shared_ptr<volphoton::Scene const> scene;
     try {
-        scene = std::make_shared<volphoton::Scene>(param->GetRegistry().BuildSceneDesc(cam));
+        scene = std::make_shared<volphoton::Scene>(param->GetRegistry().BuildSceneDesc(cam, settings.maxGridVoxels));
     } catch (std::exception const &e) {
         TF_WARN("hdVolPhoton: the scene cannot be built: %s", e.what());
         return;
     }
-    volphoton::RenderSettings settings = _delegate->GetCoreSettings();
     settings.width = width;
     settings.height = height;
     for (HdRenderPassAovBinding const &b : aovs)

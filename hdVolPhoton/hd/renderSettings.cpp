@@ -2,6 +2,10 @@
 
 #include "pxr/imaging/hd/renderDelegate.h"
 #include "pxr/imaging/hd/tokens.h"
+#include "pxr/base/tf/diagnostic.h"
+#include "pxr/base/tf/stringUtils.h"
+
+#include "core/translate/settings.h"
 
 PXR_NAMESPACE_OPEN_SCOPE
 
@@ -16,11 +20,17 @@ void HdVolPhotonRenderSettings::_Sync(HdSceneDelegate *, HdRenderParam *, HdDirt
     // XXX: with several settings prims and none active, the last one synced wins.
     if (IsActive()) *_sawActive = true;
     if ((!IsActive() && *_sawActive) || !(*dirtyBits & (DirtyActive | DirtyNamespacedSettings))) return;
-    static TfToken const samplesPerPixel("volphoton:samplesPerPixel"), threads("volphoton:threads");
+    // volphoton:<name> -> the table entry's Hydra key (convergedSamplesPerPixel, threadLimit, or
+    // volphoton:<name> itself); names not in the table are passed on and warned about by the core.
     for (auto const &[name, value] : GetNamespacedSettings()) {
-        TfToken key(name);
-        if (key == samplesPerPixel) key = HdRenderSettingsTokens->convergedSamplesPerPixel;
-        else if (key == threads) key = HdRenderSettingsTokens->threadLimit;
+        std::string const &n = name;
+        volphoton::translate::SettingInfo const *info =
+            TfStringStartsWith(n, "volphoton:") ? volphoton::translate::findSetting(n.substr(10)) : nullptr;
+        if (!info) {
+            TF_WARN("hdVolPhoton: %s.%s: unknown render setting", GetId().GetText(), n.c_str());
+            continue;
+        }
+        TfToken key(info->hydraKey);
         if (_delegate->GetRenderSetting(key) != value) _delegate->SetRenderSetting(key, value);
     }
 }

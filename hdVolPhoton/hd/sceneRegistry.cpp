@@ -3,6 +3,7 @@
 #include "pxr/base/tf/diagnostic.h"
 
 #include "core/exponentialMedium.h"
+#include "core/translate/medium.h"
 #include "core/gridMedium.h"
 
 #include <sstream>
@@ -53,34 +54,56 @@ size_t HdVolPhoton_SceneRegistry::GetLightCount() const {
     return _lights.size();
 }
 
-namespace {
-
-Bounds3 _WorldBox(std::pair<GfVec3f, GfVec3f> const &b, Affine const &xf) {
-    Bounds3 out;
-    for (int c = 0; c < 8; ++c) {
-        Vec3 p(c & 1 ? b.second[0] : b.first[0], c & 2 ? b.second[1] : b.first[1], c & 4 ? b.second[2] : b.first[2]);
-        out.extend(xf.point(p));
+MediumPtr HdVolPhoton_SceneRegistry::_GridMedium(SdfPath const &id, HdVolPhoton_VolumeRecord const &rec,
+                                                std::uint64_t maxGridVoxels, translate::Diagnostics &diagnostics) const {
+    auto fieldRecord = [&](char const *name) -> HdVolPhoton_FieldRecord const * {
+        auto it = rec.fields.find(name);
+        if (it == rec.fields.end()) return nullptr;
+        auto f = _fields.find(it->second);
+        return f == _fields.end() ? nullptr : &f->second;
+    };
+    HdVolPhoton_FieldRecord const *density = fieldRecord("density");
+    if (!density) {
+        diagnostics.error(id.GetString(), "field:density", "the density field prim was not synced; volume skipped");
+        return nullptr;
     }
-    return out;
+    GridMediumDesc g = translate::gridMediumDesc(rec.medium, rec.objectToWorld, diagnostics);
+    g.filePath = density->filePath;
+    g.densityGrid = density->fieldName.empty() ? "density" : density->fieldName;
+    g.maxActiveVoxels = maxGridVoxels;
+    for (auto [slot, target] : {std::pair<char const *, std::string *>{"temperature", &g.temperatureGrid},
+                                {"emission", &g.emissionGrid}, {"albedo", &g.albedoGrid}}) {
+        if (HdVolPhoton_FieldRecord const *f = fieldRecord(slot)) {
+            if (f->filePath != density->filePath)
+                diagnostics.error(id.GetString(), std::string("field:") + slot,
+                                  "the field is in " + f->filePath + " but the density field is in " + density->filePath +
+                                      "; every field must come from the density's file; field ignored");
+            else *target = f->fieldName.empty() ? slot : f->fieldName;
+        }
+    }
+    // Grids are cached across rebuilds by everything that shapes them: every medium parameter
+    // (translate::mediumKey), the file, the grids, the cap and the transform.
+    std::ostringstream key;
+    key.precision(17);
+    key << translate::mediumKey(rec.medium) << '|' << g.filePath << '|' << g.densityGrid << '|' << g.temperatureGrid << '|'
+        << g.emissionGrid << '|' << g.albedoGrid << '|' << g.maxActiveVoxels << '|';
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) key << g.objectToWorld.m[r][c] << ',';
+    auto cached = _gridCache.find(key.str());
+    if (cached != _gridCache.end()) return cached->second;
+    try {
+        MediumPtr medium = loadGridMedium(g);
+        _gridCache[key.str()] = medium;
+        return medium;
+    } catch (std::exception const &e) {
+        diagnostics.error(density->primPath.empty() ? id.GetString() : density->primPath, "filePath",
+                          "field:density of " + id.GetString() + " (file " + g.filePath + ", grid '" + g.densityGrid +
+                              "'): " + e.what() + "; volume skipped");
+        return nullptr;
+    }
 }
 
-/// A procedural medium (constant or exponential) for prim `id`, in world space.
-MediumPtr _ProceduralMedium(HdVolPhoton_MediumParams const &p, Affine const &xf, Bounds3 const &bounds, SdfPath const &id) {
-    MediumCoefficients c = HdVolPhoton_BuildCoefficients(p, id);
-    if (p.densityMode == TfToken("exponential")) {
-        GfVec3f up = p.expUp ? *p.expUp : GfVec3f(0, 1, 0);
-        Vec3 worldUp = xf.vector(Vec3(up[0], up[1], up[2]));
-        Vec3 origin = xf.point(Vec3(p.expOrigin[0], p.expOrigin[1], p.expOrigin[2]));
-        return std::make_shared<ExponentialMedium>(c, p.expA, p.expB, origin, worldUp, bounds);
-    }
-    if (!p.densityMode.IsEmpty() && p.densityMode != TfToken("constant") && p.densityMode != TfToken("field"))
-        TF_WARN("%s.volphoton:densityMode: unknown mode '%s'; using constant", id.GetText(), p.densityMode.GetText());
-    return std::make_shared<HomogeneousMedium>(c, bounds);
-}
-
-}  // namespace
-
-SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) const {
+SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera, std::uint64_t maxGridVoxels) const {
     std::lock_guard<std::mutex> lock(_mutex);
     SceneDesc d;
     d.camera = camera;
@@ -111,14 +134,15 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
                 }
             }
             if (rec.hasMedium) {
-                try {
-                    // The medium lives in the space of the first instance (media are not instanced).
-                    d.media.push_back(_ProceduralMedium(rec.medium, rec.instances[0], infiniteBounds(), id));
+                // The medium lives in the space of the first instance (media are not instanced).
+                translate::Diagnostics diagnostics;
+                MediumPtr medium = translate::buildProceduralMedium(rec.medium, rec.instances[0], /*useBounds=*/false, diagnostics);
+                HdVolPhoton_Report(diagnostics);
+                if (medium) {
+                    d.media.push_back(medium);
                     mesh.interiorMedium = static_cast<int>(d.media.size()) - 1;
-                    mesh.material.kind = rec.medium.ior > 1.0f ? SurfaceMaterial::Kind::Dielectric : SurfaceMaterial::Kind::Boundary;
+                    mesh.material.kind = rec.medium.ior > 1.0 ? SurfaceMaterial::Kind::Dielectric : SurfaceMaterial::Kind::Boundary;
                     mesh.material.ior = rec.medium.ior;
-                } catch (std::exception const &e) {
-                    TF_WARN("%s: medium ignored: %s", id.GetText(), e.what());
                 }
             }
             d.meshes.push_back(std::move(mesh));
@@ -129,69 +153,18 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
         }
     }
     for (auto const &[id, rec] : _volumes) {
-        HdVolPhoton_MediumParams const &p = rec.medium;
-        bool hasDensityField = rec.fields.count("density") > 0;
-        TfToken mode = p.densityMode.IsEmpty() ? TfToken(hasDensityField ? "field" : "constant") : p.densityMode;
-        try {
-            MediumPtr medium;
-            if (mode == TfToken("field")) {
-                if (!hasDensityField) {
-                    TF_WARN("%s.volphoton:densityMode: 'field' but no density field is bound; volume skipped", id.GetText());
-                    continue;
-                }
-                auto fieldRecord = [&](char const *name) -> HdVolPhoton_FieldRecord const * {
-                    auto it = rec.fields.find(name);
-                    if (it == rec.fields.end()) return nullptr;
-                    auto f = _fields.find(it->second);
-                    return f == _fields.end() ? nullptr : &f->second;
-                };
-                HdVolPhoton_FieldRecord const *density = fieldRecord("density");
-                if (!density) {
-                    TF_WARN("%s: the density field prim %s was not synced; volume skipped", id.GetText(),
-                            rec.fields.at("density").GetText());
-                    continue;
-                }
-                GridMediumDesc g;
-                g.filePath = density->filePath;
-                g.densityGrid = density->fieldName.empty() ? "density" : density->fieldName;
-                for (auto [slot, target] : {std::pair<char const *, std::string *>{"temperature", &g.temperatureGrid},
-                                            {"emission", &g.emissionGrid}, {"albedo", &g.albedoGrid}}) {
-                    if (HdVolPhoton_FieldRecord const *f = fieldRecord(slot)) {
-                        if (f->filePath != density->filePath)
-                            TF_WARN("%s: field '%s' is in another file than the density; ignored", id.GetText(), slot);
-                        else *target = f->fieldName;
-                    }
-                }
-                g.densityScale = p.density;
-                g.extinctionColor = {p.extinctionColor[0], p.extinctionColor[1], p.extinctionColor[2]};
-                g.albedo = {p.albedo[0], p.albedo[1], p.albedo[2]};
-                g.emission = {p.emission[0], p.emission[1], p.emission[2]};
-                g.emissionScale = p.emissionScale;
-                g.temperatureScale = p.temperatureScale;
-                g.phase = HdVolPhoton_BuildPhase(p, id);
-                g.objectToWorld = rec.objectToWorld;
-                std::ostringstream key;  // grids are cached across rebuilds by everything that shapes them
-                key << id << '|' << g.filePath << '|' << g.densityGrid << '|' << g.temperatureGrid << '|' << g.emissionGrid
-                    << '|' << g.albedoGrid << '|' << g.densityScale << '|' << p.albedo << '|' << p.extinctionColor << '|'
-                    << p.emission << '|' << g.emissionScale << '|' << g.temperatureScale << '|' << p.phase << p.g << '|';
-                for (int r = 0; r < 3; ++r)
-                    for (int c = 0; c < 4; ++c) key << g.objectToWorld.m[r][c] << ',';
-                auto cached = _gridCache.find(key.str());
-                if (cached != _gridCache.end()) {
-                    medium = cached->second;
-                } else {
-                    medium = loadGridMedium(g);
-                    _gridCache[key.str()] = medium;
-                }
-            } else {
-                Bounds3 bounds = p.bounds ? _WorldBox(*p.bounds, rec.objectToWorld) : infiniteBounds();
-                medium = _ProceduralMedium(p, rec.objectToWorld, bounds, id);
-            }
-            d.media.push_back(medium);
-            d.unboundedMedia.push_back(static_cast<int>(d.media.size()) - 1);
-        } catch (std::exception const &e) {
-            TF_WARN("%s: volume skipped: %s", id.GetText(), e.what());
+        translate::MediumParams const &p = rec.medium;
+        translate::Diagnostics diagnostics;
+        MediumPtr medium;
+        if (p.densityMode == "field") {
+            medium = _GridMedium(id, rec, maxGridVoxels, diagnostics);
+        } else {
+            medium = translate::buildProceduralMedium(p, rec.objectToWorld, /*useBounds=*/true, diagnostics);
         }
+        HdVolPhoton_Report(diagnostics);
+        if (!medium) continue;
+        d.media.push_back(medium);
+        d.unboundedMedia.push_back(static_cast<int>(d.media.size()) - 1);
     }
     for (auto const &[id, light] : _lights) d.lights.push_back(light);
     return d;

@@ -29,7 +29,7 @@ struct HdVolPhoton_MeshRecord {
     std::vector<volphoton::Affine> instances;  ///< world transforms (one when not instanced)
     int primId = -1;  ///< HdRprim::GetPrimId(): what the primId AOV reports (instanceId: index into instances)
     bool hasMedium = false;
-    HdVolPhoton_MediumParams medium;
+    volphoton::translate::MediumParams medium;
     SdfPath materialId;  ///< bound material of the faces in no subset
     std::vector<HdVolPhoton_SubsetRecord> subsets;
 };
@@ -42,6 +42,7 @@ struct HdVolPhoton_MaterialRecord {
 
 /// An OpenVDB field prim (openvdbAsset): where its grid is.
 struct HdVolPhoton_FieldRecord {
+    std::string primPath;  ///< the OpenVDBAsset prim, for messages
     std::string filePath;
     std::string fieldName;
     int fieldIndex = 0;
@@ -50,7 +51,7 @@ struct HdVolPhoton_FieldRecord {
 /// A volume as synced: its medium parameters, transform and the field prims it binds by name
 /// (density, temperature, emission, albedo).
 struct HdVolPhoton_VolumeRecord {
-    HdVolPhoton_MediumParams medium;
+    volphoton::translate::MediumParams medium;
     volphoton::Affine objectToWorld;
     std::map<std::string, SdfPath> fields;
 };
@@ -73,7 +74,8 @@ public:
     /// Translates everything into the core's description: loads VDB grids (cached by file, grid
     /// and parameters), builds media and lights. Problems become TF_WARN messages naming the prim,
     /// and the prim is left out; the rest still renders.
-    volphoton::SceneDesc BuildSceneDesc(volphoton::CameraDesc const &camera) const;
+    /// maxGridVoxels: the grid-size cap (RenderSettings::maxGridVoxels).
+    volphoton::SceneDesc BuildSceneDesc(volphoton::CameraDesc const &camera, std::uint64_t maxGridVoxels) const;
 
     /// Counts for render stats.
     size_t GetMeshCount() const;
@@ -81,6 +83,10 @@ public:
     size_t GetLightCount() const;
 
 private:
+    /// The grid medium of a field-mode volume (cached), or null with the reason in diagnostics.
+    volphoton::MediumPtr _GridMedium(SdfPath const &id, HdVolPhoton_VolumeRecord const &rec, std::uint64_t maxGridVoxels,
+                                     volphoton::translate::Diagnostics &diagnostics) const;
+
     mutable std::mutex _mutex;
     std::map<SdfPath, HdVolPhoton_MeshRecord> _meshes;
     std::map<SdfPath, HdVolPhoton_VolumeRecord> _volumes;

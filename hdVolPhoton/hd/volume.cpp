@@ -30,7 +30,6 @@ void HdVolPhotonVolume::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *rend
         return;
     }
     HdVolPhoton_VolumeRecord rec;
-    rec.medium = HdVolPhoton_ReadMediumParams(sceneDelegate, id).value_or(HdVolPhoton_MediumParams());
     rec.objectToWorld = HdVolPhoton_ToAffine(sceneDelegate->GetTransform(id));
     if (!rec.objectToWorld.inverse()) {
         TF_WARN("%s: the transform is not invertible or not finite; volume skipped", id.GetText());
@@ -47,6 +46,9 @@ void HdVolPhotonVolume::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *rend
         }
         rec.fields[f.fieldName.GetString()] = f.fieldId;
     }
+    // A Volume is always a medium (schema defaults without the API).
+    rec.medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/true, rec.fields.count("density") > 0)
+                     .value_or(volphoton::translate::MediumParams());
     registry.SetVolume(id, std::move(rec));
     *dirtyBits &= ~HdChangeTracker::AllSceneDirtyBits;
 }

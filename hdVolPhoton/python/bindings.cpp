@@ -654,6 +654,7 @@ PYBIND11_MODULE(_core, m) {
         .def_readwrite("transmittance_cutoff", &RenderSettings::transmittanceCutoff)
         .def_readwrite("photon_map_budget_bytes", &RenderSettings::photonMapBudgetBytes)
         .def_readwrite("dome_visible_to_camera", &RenderSettings::domeVisibleToCamera)
+        .def_readwrite("max_grid_voxels", &RenderSettings::maxGridVoxels)
         .def("to_dict", &settingsToDict, "Settings under their documented (integrator.h) names")
         .def("__repr__", [](const RenderSettings& s) { return py::repr(settingsToDict(s)).cast<std::string>(); });
 
@@ -726,4 +727,5 @@ PYBIND11_MODULE(_core, m) {
     volphoton::bindings::registerImage(m);
     volphoton::bindings::registerVdbTestHelpers(m);
     volphoton::bindings::registerGltf(m);
+    volphoton::bindings::registerTranslate(m);
 }

@@ -58,11 +58,7 @@ def build(usd_path, width, height, integrator="pathTracer", threads=0, seed=0, c
     errors = [str(d) for d in tr.diagnostics if d.severity == "error"]
     if errors:
         raise RuntimeError("translating %s: %s" % (usd_path, "; ".join(errors)))
-    s = core.RenderSettings()
-    for name, value in rs.overrides.items():
-        if name == "integrator":
-            continue
-        setattr(s, name, value)
+    s = rs.settings  # the stage's volphoton:* settings (the integrator is the caller's)
     s.width, s.height = width, height
     s.threads = threads
     s.seed = seed

@@ -278,6 +278,36 @@ def _integrator(text: str) -> str:
     raise argparse.ArgumentTypeError("unknown integrator %r (pathtracer or photonmap)" % text)
 
 
+def _core_settings_table(core=None):
+    if core is None:
+        from . import _core as core
+    return core.render_settings_table()
+
+
+def _flag_dest(flag: str) -> str:
+    return flag.lstrip("-").replace("-", "_")
+
+
+def _add_setting_flags(parser) -> None:
+    """One flag per setting of the core's table that has one (core/translate/settings.h): its help
+    is the table's meaning and default; the value goes through the same validation as a
+    RenderSettings prim's volphoton:<name> (and overrides it)."""
+    for e in _core_settings_table():
+        if not e["cli_flag"]:
+            continue
+        if e["type"] == "choice":
+            kind = dict(type=_integrator, metavar="|".join(c.lower() for c in e["choices"]))
+        elif e["type"] == "int":
+            kind = dict(type=_positive_int if e["min"] >= 1 else _non_negative_int, metavar="N")
+        else:
+            kind = dict(type=float, metavar="X")
+        default = e["default"]
+        default = "2^30" if e["name"] == "maxGridVoxels" else default
+        parser.add_argument(e["cli_flag"], dest=_flag_dest(e["cli_flag"]),
+                            help="%s (default %s; RenderSettings prim: volphoton:%s)" % (e["meaning"], default, e["name"]),
+                            **kind)
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="volphoton", description="Render USD scenes with participating media "
                                  "(hdVolPhoton on usd-core).", epilog="Run 'volphoton render -h' for the options.")
@@ -296,17 +326,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--camera", metavar="PATH", help="UsdGeomCamera prim path (default: RenderSettings camera, "
                    "else the first camera)")
     r.add_argument("--resolution", nargs=2, type=_positive_int, metavar=("W", "H"))
-    r.add_argument("--spp", type=_positive_int, metavar="N", help="samples (passes) per pixel (default 16)")
-    r.add_argument("--integrator", type=_integrator, help="pathtracer (default) or photonmap")
     r.add_argument("--frames", metavar="A:B", help="frame range, inclusive (A:B[:STEP], comma lists)")
-    r.add_argument("--seed", type=_non_negative_int, help="random seed (default 0)")
-    r.add_argument("--threads", type=_non_negative_int, help="render threads (0 = all cores)")
-    r.add_argument("--photons", type=_non_negative_int, metavar="N", help="photons per pass (photonmap)")
-    r.add_argument("--max-depth", type=_non_negative_int, metavar="N", help="scattering/bounce events per path")
     r.add_argument("--stats", metavar="STATS.json", help="write render statistics as JSON")
-    r.add_argument("--max-grid-voxels", type=_non_negative_int, metavar="N",
-                   help="grid-size cap: refuse VDB grids with more active voxels (default 2^30; 0 = no cap; "
-                   "the RenderSettings prim's volphoton:maxGridVoxels otherwise)")
+    _add_setting_flags(r)
     png = r.add_mutually_exclusive_group()
     png.add_argument("--png", metavar="OUT.png", help="display image (default: the EXR name with .png)")
     png.add_argument("--no-png", action="store_true", help="do not write the display image")
@@ -375,25 +397,17 @@ def _frame_times(stage, frames_spec: Optional[str]):
 
 
 def _settings(core, args, rs_info, width: int, height: int):
-    s = core.RenderSettings()
-    for name, value in rs_info.overrides.items():
-        if name == "integrator":
-            value = core.RenderSettings.Integrator.PhotonMap if value == "photonMap" else core.RenderSettings.Integrator.PathTracer
-        setattr(s, name, value)
+    """The stage's RenderSettings prim values, then the command line's flags on top (both through the
+    settings table of core/translate/settings.h)."""
+    s = rs_info.settings
     s.width, s.height = width, height
-    if args.spp is not None:
-        s.samples_per_pixel = args.spp
-    if args.integrator is not None:
-        s.integrator = (core.RenderSettings.Integrator.PhotonMap if args.integrator == "photonMap"
-                        else core.RenderSettings.Integrator.PathTracer)
-    if args.seed is not None:
-        s.seed = args.seed
-    if args.threads is not None:
-        s.threads = args.threads
-    if args.photons is not None:
-        s.photons_per_pass = args.photons
-    if args.max_depth is not None:
-        s.max_depth = args.max_depth
+    for entry in _core_settings_table(core):
+        value = getattr(args, _flag_dest(entry["cli_flag"]), None) if entry["cli_flag"] else None
+        if value is None:
+            continue
+        ok, diags = core.apply_setting(s, entry["name"], value)
+        if not ok:
+            raise RenderError("%s: %s" % (entry["cli_flag"], "; ".join(m for _, _, _, m in diags)))
     return s
 
 
@@ -492,7 +506,7 @@ def cmd_render(args) -> int:
 def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path, rs_info, display,
                   progress, reporter, index, count) -> dict:
     t0 = _time.perf_counter()
-    cap = args.max_grid_voxels if args.max_grid_voxels is not None else rs_info.max_grid_voxels
+    cap = settings.max_grid_voxels
     scene = usdscene.translate(stage, tc, settings.width, settings.height, camera_path, rs_info.conform_policy, cap)
     for d in _unique(scene.diagnostics):
         reporter.diagnostic(d)

@@ -139,14 +139,13 @@ def _lookup(name: str) -> Tuple[Vec3, Vec3]:
 
 
 def preset_coefficients(name: str, scene_units_per_mm: float = 1.0, g: float = 0.0) -> PresetCoefficients:
-    """The preset's sigma_s = sigma_s' / (1 - g) and sigma_a, in 1/scene unit (see the module doc).
+    """The preset's sigma_s = sigma_s' / (1 - g) and sigma_a, in 1/scene unit (see the module doc; the
+    mapping is the C++ core's, core/presets.h, which both front ends use).
 
     Raises UnknownPresetError for a name not in PRESETS and ValueError for scene_units_per_mm <= 0
     or g outside (-1, 1)."""
-    ssp, sa = _lookup(name)
-    if not scene_units_per_mm > 0:
-        raise ValueError("sceneUnitsPerMm = %r must be > 0" % (scene_units_per_mm,))
-    if not -1.0 < g < 1.0:
-        raise ValueError("mean cosine g = %r must be in (-1, 1)" % (g,))
-    u = float(scene_units_per_mm)
-    return PresetCoefficients(tuple(s / (1.0 - g) / u for s in ssp), tuple(a / u for a in sa))  # type: ignore[arg-type]
+    from . import _core
+
+    _lookup(name)
+    sigma_s, sigma_a = _core.preset_coefficients(name, float(scene_units_per_mm), float(g))
+    return PresetCoefficients(tuple(sigma_s), tuple(sigma_a))  # type: ignore[arg-type]

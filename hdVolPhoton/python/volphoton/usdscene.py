@@ -127,27 +127,14 @@ __all__ = [
 # Measured subsurface coefficients (volphoton:preset): the table lives in volphoton/presets.py.
 PRESETS = vpresets.PRESETS
 
-# Renderer settings read from a UsdRender Settings prim as ``volphoton:<name>`` attributes (the
-# names of integrator.h's table): name -> (RenderSettings field, Python type).
-SETTINGS_ATTRIBUTES = {
-    "integrator": ("integrator", str),
-    "samplesPerPixel": ("samples_per_pixel", int),
-    "maxDepth": ("max_depth", int),
-    "rouletteDepth": ("roulette_depth", int),
-    "seed": ("seed", int),
-    "threads": ("threads", int),
-    "photonsPerPass": ("photons_per_pass", int),
-    "initialRadius": ("initial_radius", float),
-    "radiusAlpha": ("radius_alpha", float),
-    "photonRadiusMfp": ("photon_radius_mfp", float),
-    "stratifiedDims": ("stratified_dims", int),
-    "marchStep": ("march_step", float),
-    "singleScattering": ("single_scattering", bool),
-    "multipleScattering": ("multiple_scattering", bool),
-    "multipleThreshold": ("multiple_threshold", float),
-    "transmittanceCutoff": ("transmittance_cutoff", float),
-}
+# Renderer settings read from a UsdRender Settings prim as ``volphoton:<name>`` attributes: the C++
+# table (core/translate/settings.h) the CLI flags and the Hydra delegate share.
+SETTINGS_TABLE = {e["name"]: e for e in _core.render_settings_table()}
+SETTINGS_ATTRIBUTES = tuple(SETTINGS_TABLE)
 
+# UsdLux schema -> the translation layer's light kinds (anything else: "not supported").
+_LIGHT_KINDS = (("distant", UsdLux.DistantLight), ("sphere", UsdLux.SphereLight), ("rect", UsdLux.RectLight),
+                ("disk", UsdLux.DiskLight), ("dome", UsdLux.DomeLight))
 SPHERE_SEGMENTS, SPHERE_RINGS = 48, 24
 CYLINDER_SEGMENTS = 48
 DEFAULT_ALBEDO = (0.18, 0.18, 0.18)
@@ -213,8 +200,9 @@ class RenderSettingsInfo:
     resolution: Optional[Tuple[int, int]] = None
     camera_path: Optional[str] = None
     conform_policy: str = "expandAperture"
-    overrides: Dict[str, object] = field(default_factory=dict)  # RenderSettings field -> value
-    max_grid_voxels: Optional[int] = None  # volphoton:maxGridVoxels (grid-size cap; 0 = none)
+    overrides: Dict[str, object] = field(default_factory=dict)  # setting name -> validated value
+    settings: object = field(default_factory=lambda: _core.RenderSettings())  # defaults + overrides
+    max_grid_voxels: Optional[int] = None  # volphoton:maxGridVoxels when authored (grid-size cap; 0 = none)
     diagnostics: List[Diagnostic] = field(default_factory=list)
 
 
@@ -297,14 +285,6 @@ class _Diags:
 
     def info(self, prim, attr: str, msg: str) -> None:
         self.out.append(Diagnostic("info", str(prim), attr, msg))
-
-
-def _attr_value(prim: Usd.Prim, name: str, time, default=None):
-    attr = prim.GetAttribute(name)
-    if not attr:
-        return default
-    v = attr.Get(time)
-    return default if v is None else v
 
 
 # --------------------------------------------------------------------------------------------------
@@ -610,39 +590,6 @@ def _display_color(prim: Usd.Prim, time):
 # --------------------------------------------------------------------------------------------------
 
 
-def phase_to_core(p: vschema.PhaseDesc):
-    k = p.kind
-    if k == "isotropic":
-        return _core.isotropic_phase()
-    if k == "linear":
-        return _core.linear_phase(p.x)
-    if k == "rayleigh":
-        return _core.rayleigh_phase()
-    if k == "lambertianSphere":
-        return _core.lambertian_sphere_phase()
-    if k == "schlick":
-        return _core.schlick_phase(p.k)
-    if k == "tabulated":
-        return _core.tabulated_phase(list(p.table))
-    if k == "mixture":
-        return _core.mixture_phase([(float(w), phase_to_core(l)) for w, l in p.lobes])
-    return _core.henyey_greenstein_phase(p.g)
-
-
-def _coefficients(md: vschema.MediumDesc, prim_path: str, d: _Diags):
-    """(density, extinction colour, albedo) after applying a preset."""
-    density, ext, albedo = md.density, md.extinction_color, md.albedo
-    if md.preset:
-        try:
-            g = phase_to_core(md.phase).mean_cosine()  # sigma_s = sigma_s' / (1 - g)
-            c = vpresets.preset_coefficients(md.preset, md.scene_units_per_mm, g)
-        except (vpresets.UnknownPresetError, ValueError) as e:
-            d.error(prim_path, "volphoton:preset", "%s; using the authored density, albedo and extinctionColor" % e)
-        else:
-            density, ext, albedo = c.density, c.extinction_color, c.albedo
-    return density, ext, albedo
-
-
 class _Translator:
     def __init__(self, stage: Usd.Stage, time: Usd.TimeCode):
         self.stage = stage
@@ -868,28 +815,9 @@ class _Translator:
 
     # -- media -------------------------------------------------------------------------------------
     def _procedural_medium(self, prim, md: vschema.MediumDesc, world: np.ndarray, use_bounds: bool):
-        path = str(prim.GetPath())
-        density, ext, albedo = _coefficients(md, path, self.d)
-        emission = tuple(c * md.emission_scale for c in md.emission)
-        try:
-            coeffs = _core.MediumCoefficients.from_albedo(density, ext, albedo, emission, phase_to_core(md.phase))
-            bounds = None
-            if use_bounds and md.bounds is not None:
-                bounds = _world_box(world, md.bounds[0], md.bounds[1])
-            if md.density_mode == "exponential":
-                origin = _point(world, md.exp_origin)
-                up = _vector(world, md.exp_up)
-                length = float(np.linalg.norm(up))
-                if not (length > 0) or not _finite(up):
-                    self.d.error(path, "volphoton:exponential:up", "up direction degenerates under the prim's "
-                                 "transform; medium skipped")
-                    return None, ""
-                return _core.ExponentialMedium(coeffs, md.exp_a, md.exp_b / length, _tuple3(origin),
-                                               _tuple3(up / length), bounds), "exponential"
-            return _core.HomogeneousMedium(coeffs, bounds), "homogeneous"
-        except (ValueError, RuntimeError) as e:
-            self.d.error(path, "", "cannot build the medium: %s; skipped" % e)
-            return None, ""
+        medium, kind, diags = _core.build_procedural_medium(md.core, world, use_bounds)
+        self.diags.extend(vschema.diagnostics_from_core(diags))
+        return medium, kind
 
     def volume(self, prim: Usd.Prim) -> None:
         path = prim.GetPath()
@@ -918,7 +846,8 @@ class _Translator:
         dens = md.fields.get("density")
         if dens is None or not dens.file_path:
             return None  # read_medium reported why
-        gd = _core.GridMediumDesc()
+        gd, diags = _core.grid_medium_desc(md.core, world)  # every medium parameter (core/translate)
+        self.diags.extend(vschema.diagnostics_from_core(diags))
         gd.file_path = dens.file_path
         gd.density_grid = dens.field_name or "density"
         if dens.field_index >= 0:
@@ -934,15 +863,6 @@ class _Translator:
                              % (fname, path, f.file_path, dens.file_path))
                 continue
             setattr(gd, attr, f.field_name or fname)
-        density, ext, albedo = _coefficients(md, path, self.d)
-        gd.density_scale = density
-        gd.extinction_color = ext
-        gd.albedo = albedo
-        gd.emission = md.emission
-        gd.emission_scale = md.emission_scale
-        gd.temperature_scale = md.temperature_scale
-        gd.phase = phase_to_core(md.phase)
-        gd.object_to_world = world
         gd.max_active_voxels = self.max_grid_voxels
         problem = vdbguard.crash_check(gd.file_path, gd.density_grid)
         if problem:
@@ -1020,141 +940,26 @@ class _Translator:
 
     # -- lights ------------------------------------------------------------------------------------
     def light(self, prim: Usd.Prim) -> None:
+        """Reads the UsdLux attributes the translation layer uses (core/translate/light.h has the
+        rules) and adds the light it builds."""
         path = prim.GetPath()
-        t = self.time
-        api = UsdLux.LightAPI(prim)
         world = self.world(prim)
         if world is None:
             return
-        intensity = float(api.GetIntensityAttr().Get(t))
-        exposure = float(api.GetExposureAttr().Get(t))
-        color = _tuple3(api.GetColorAttr().Get(t))
-        normalize = bool(api.GetNormalizeAttr().Get(t))
-        for name, v in (("inputs:intensity", intensity), ("inputs:exposure", exposure), ("inputs:color", color)):
-            if not _finite(v):
-                self.d.error(path, name, "%s is not finite; light skipped" % name.split(":")[-1])
-                return
-        if intensity < 0 or min(color) < 0:
-            self.d.warn(path, "inputs:intensity" if intensity < 0 else "inputs:color",
-                        "negative emission clamped to 0")
-            intensity = max(intensity, 0.0)
-            color = tuple(max(c, 0.0) for c in color)
-        scale = intensity * 2.0 ** exposure
-        rgb = np.array(color) * scale
-        if api.GetEnableColorTemperatureAttr().Get(t):
-            kelvin = float(api.GetColorTemperatureAttr().Get(t))
-            rgb = rgb * np.array(UsdLux.BlackbodyTemperatureAsRgb(kelvin), dtype=np.float64)
-        for name in ("inputs:diffuse", "inputs:specular"):
-            v = _attr_value(prim, name, t, 1.0)
-            if v != 1.0:
-                self.d.warn(path, name, "%s = %g is a non-physical control and is ignored" % (name.split(":")[-1], v))
-        if api.GetFiltersRel().GetForwardedTargets():
-            self.d.warn(path, "light:filters", "light filters are not supported; ignored")
-        pos = _point(world, (0, 0, 0))
-        axis = _vector(world, (0, 0, -1))
-        axis_len = float(np.linalg.norm(axis))
-        axis = axis / axis_len if axis_len > 0 else np.array([0.0, 0.0, -1.0])
-        lin_scale = abs(float(np.linalg.det(world[:3, :3]))) ** (1.0 / 3.0)
-        params: dict = {}
-        try:
-            if prim.IsA(UsdLux.DistantLight):
-                angle = float(UsdLux.DistantLight(prim).GetAngleAttr().Get(t))
-                half = math.radians(min(max(angle, 0.0), 180.0)) / 2.0
-                if normalize or half == 0.0:
-                    E = rgb
-                else:
-                    E = rgb * math.pi * math.sin(half) ** 2
-                params = {"direction": _tuple3(axis), "half_angle": half, "normalize": normalize}
-                light = _core.distant_light(_tuple3(axis), half, _tuple3(E))
-                self._add_light(prim, "distant", E, "irradiance", params, light)
-            elif prim.IsA(UsdLux.SphereLight):
-                sl = UsdLux.SphereLight(prim)
-                r = float(sl.GetRadiusAttr().Get(t)) * lin_scale
-                point = bool(sl.GetTreatAsPointAttr().Get(t)) or r <= 0
-                L = rgb / (4.0 * math.pi * r * r) if normalize and r > 0 else rgb
-                shaping = self._shaping(prim)
-                if point:
-                    emission, quantity, radius = (L * math.pi * r * r if r > 0 else L), "intensity", 0.0
-                else:
-                    emission, quantity, radius = L, "radiance", r
-                params = {"position": _tuple3(pos), "radius": radius, "authored_radius": r, "normalize": normalize}
-                if shaping is not None:
-                    cone, softness = shaping
-                    params.update(axis=_tuple3(axis), cone_angle=cone, cone_softness=softness)
-                    light = _core.spot_light(_tuple3(pos), radius, _tuple3(emission), _tuple3(axis), cone, softness)
-                    kind = "spot"
-                else:
-                    light = _core.sphere_light(_tuple3(pos), radius, _tuple3(emission))
-                    kind = "point" if radius == 0 else "sphere"
-                self._add_light(prim, kind, emission, quantity, params, light)
-            elif prim.IsA(UsdLux.RectLight) or prim.IsA(UsdLux.DiskLight):
-                rect = prim.IsA(UsdLux.RectLight)
-                ex, ey = _vector(world, (1, 0, 0)), _vector(world, (0, 1, 0))
-                stretch = float(np.linalg.norm(np.cross(ex, ey)))
-                if rect:
-                    rl = UsdLux.RectLight(prim)
-                    w, h = float(rl.GetWidthAttr().Get(t)), float(rl.GetHeightAttr().Get(t))
-                    area = w * h * stretch
-                    if rl.GetTextureFileAttr().Get(t):
-                        self.d.warn(path, "inputs:texture:file", "rect light textures are not supported; ignored")
-                else:
-                    r = float(UsdLux.DiskLight(prim).GetRadiusAttr().Get(t))
-                    area = math.pi * r * r * stretch
-                L = rgb / area if normalize and area > 0 else rgb
-                params = {"position": _tuple3(pos), "normal": _tuple3(axis), "area": area, "normalize": normalize}
-                if rect:
-                    params.update(width=w, height=h)
-                    light = _core.rect_light(world, w, h, _tuple3(L))
-                else:
-                    params.update(radius=r)
-                    light = _core.disk_light(world, r, _tuple3(L))
-                self._add_light(prim, "rect" if rect else "disk", L, "radiance", params, light)
-            elif prim.IsA(UsdLux.DomeLight):
-                dl = UsdLux.DomeLight(prim)
-                image = None
-                tex = dl.GetTextureFileAttr().Get(t)
-                fmt = str(dl.GetTextureFormatAttr().Get(t) or "automatic")
-                if tex is not None and tex.path:
-                    if fmt not in ("automatic", "latlong"):
-                        self.d.warn(path, "inputs:texture:format", "format '%s' is not supported; the texture is "
-                                    "read as lat-long" % fmt)
-                    if not tex.resolvedPath:
-                        self.d.error(path, "inputs:texture:file", "cannot resolve @%s@; using a constant dome"
-                                     % tex.path)
-                    else:
-                        try:
-                            image = _core.load_lat_long_exr(tex.resolvedPath)
-                        except (RuntimeError, ValueError) as e:
-                            self.d.error(path, "inputs:texture:file", "%s; using a constant dome" % e)
-                params = {"texture": image is not None and tex.resolvedPath or "", "normalize": normalize}
-                light = _core.dome_light(_tuple3(rgb), image, world)
-                self._add_light(prim, "dome", rgb, "radiance", params, light)
-            else:
-                self.d.warn(path, "", "%s lights are not supported; ignored" % (prim.GetTypeName() or "this kind of"))
-        except (ValueError, RuntimeError) as e:
-            self.d.error(path, "", "cannot create the light: %s; skipped" % e)
-
-    def _shaping(self, prim: Usd.Prim):
-        if not prim.HasAPI(UsdLux.ShapingAPI):
-            return None
-        sh = UsdLux.ShapingAPI(prim)
-        t = self.time
-        angle = float(sh.GetShapingConeAngleAttr().Get(t))
-        softness = float(sh.GetShapingConeSoftnessAttr().Get(t))
-        if float(sh.GetShapingFocusAttr().Get(t) or 0) != 0:
-            self.d.warn(prim.GetPath(), "inputs:shaping:focus", "shaping focus is not supported; ignored")
-        ies = sh.GetShapingIesFileAttr().Get(t)
-        if ies is not None and ies.path:
-            self.d.warn(prim.GetPath(), "inputs:shaping:ies:file", "IES profiles are not supported; ignored")
-        if not (_finite(angle) and _finite(softness)):
-            self.d.error(prim.GetPath(), "inputs:shaping:cone:angle", "cone angle/softness not finite; no cone")
-            return None
-        if angle >= 180.0:
-            return None
-        if angle <= 0.0:
-            self.d.warn(prim.GetPath(), "inputs:shaping:cone:angle", "cone angle %g <= 0; using 0.01 degrees" % angle)
-            angle = 0.01
-        return math.radians(angle), min(max(softness, 0.0), 1.0)
+        kind = next((k for k, t in _LIGHT_KINDS if prim.IsA(t)), "")
+        values, _ = vschema.read_attributes(prim, self.time, prefix="")
+        wanted = set(_core.light_attribute_names())
+        values = {k: v for k, v in values.items() if k in wanted}
+        tex = prim.GetAttribute("inputs:texture:file").Get(self.time) if kind == "dome" else None
+        asset = tex.path if tex is not None else ""
+        if kind == "dome":
+            values["inputs:texture:file"] = tex.resolvedPath if tex is not None else ""
+        has_filters = bool(UsdLux.LightAPI(prim).GetFiltersRel().GetForwardedTargets())
+        light, kind, emission, quantity, params, diags = _core.translate_light(
+            str(path), values, kind, str(prim.GetTypeName()), world, has_filters, asset)
+        self.diags.extend(vschema.diagnostics_from_core(diags))
+        if light is not None:
+            self._add_light(prim, kind, emission, quantity, params, light)
 
     def _add_light(self, prim, kind, emission, quantity, params, light) -> None:
         self.desc.add_light(light)
@@ -1212,42 +1017,17 @@ def read_render_settings(stage: Usd.Stage) -> RenderSettingsInfo:
     if par is not None and abs(float(par) - 1.0) > 1e-6:
         d.warn(prim.GetPath(), "pixelAspectRatio", "pixelAspectRatio %g is not supported; square pixels are "
                "rendered" % par)
-    for name, (fieldname, typ) in SETTINGS_ATTRIBUTES.items():
-        attr = prim.GetAttribute("volphoton:" + name)
-        if not attr or not attr.HasAuthoredValue():
-            continue
-        v = attr.Get()
-        try:
-            if typ is bool:
-                if not isinstance(v, (bool, int)):
-                    raise ValueError
-                value = bool(v)
-            elif typ is str:
-                value = str(v)
-                if value not in ("pathTracer", "photonMap"):
-                    raise ValueError
-            else:
-                if isinstance(v, (str, bool)):
-                    raise ValueError
-                value = typ(v)
-                if typ is float and not math.isfinite(value):
-                    raise ValueError
-        except (TypeError, ValueError):
-            d.error(prim.GetPath(), "volphoton:" + name, "unusable value %r; ignored" % (v,))
-            continue
-        info.overrides[fieldname] = value
-    cap = prim.GetAttribute("volphoton:maxGridVoxels")
-    if cap and cap.HasAuthoredValue():
-        v = cap.Get()
-        if isinstance(v, int) and not isinstance(v, bool) and v >= 0:
-            info.max_grid_voxels = int(v)
-        else:
-            d.error(prim.GetPath(), "volphoton:maxGridVoxels", "unusable value %r (a voxel count >= 0); ignored" % (v,))
     for attr in prim.GetAuthoredAttributes():
         n = attr.GetName()
-        if n.startswith("volphoton:") and n[len("volphoton:"):] not in SETTINGS_ATTRIBUTES \
-                and n != "volphoton:maxGridVoxels":
-            d.warn(prim.GetPath(), n, "unknown render setting (known: %s)" % ", ".join(SETTINGS_ATTRIBUTES))
+        if not n.startswith("volphoton:") or not attr.HasAuthoredValue():
+            continue
+        name = n[len("volphoton:"):]
+        ok, diags = _core.apply_setting(info.settings, name, vschema.plain_value(attr.Get()), str(prim.GetPath()))
+        info.diagnostics.extend(vschema.diagnostics_from_core(diags))
+        if ok:
+            info.overrides[name] = _core.get_setting(info.settings, name)
+    if "maxGridVoxels" in info.overrides:
+        info.max_grid_voxels = int(info.overrides["maxGridVoxels"])
     return info
 
 
