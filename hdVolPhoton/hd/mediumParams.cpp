@@ -7,6 +7,7 @@
 #include "pxr/base/tf/diagnostic.h"
 #include "pxr/base/tf/stringUtils.h"
 #include "pxr/base/vt/array.h"
+#include "pxr/imaging/hd/renderIndex.h"
 #include "pxr/imaging/hd/sceneDelegate.h"
 #include "pxr/usd/sdf/assetPath.h"
 #include "pxr/usd/usd/attribute.h"
@@ -83,8 +84,12 @@ AttrValue HdVolPhoton_ToAttrValue(VtValue const &v) {
 }
 
 UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sd, SdfPath const &id, UsdTimeCode *time) {
+    if (!sd || id.IsEmpty()) return UsdPrim();
+    // With scene-index emulation (OpenUSD's default) the prims see HdSceneIndexAdapterSceneDelegate;
+    // the render index still answers with the UsdImagingDelegate that inserted the rprim.
     auto *usd = dynamic_cast<UsdImagingDelegate *>(sd);
-    if (!usd || id.IsEmpty()) return UsdPrim();
+    if (!usd) usd = dynamic_cast<UsdImagingDelegate *>(sd->GetRenderIndex().GetSceneDelegateForRprim(id));
+    if (!usd) return UsdPrim();
     _PrimAccess access;
     access.SetDelegate(usd);
     if (time) *time = usd->GetTime();

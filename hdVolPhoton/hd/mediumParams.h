@@ -3,8 +3,9 @@
 // stage's up axis. The rules themselves are the core's, the same the usd-core front end applies.
 //
 // Where the values come from:
-//  * the legacy scene delegate (UsdImagingDelegate, OpenUSD 24.08's default for usdrecord/usdview):
-//    the UsdPrim itself (HdVolPhoton_FindUsdPrim), read exactly as the usd-core front end reads it;
+//  * the legacy scene delegate (UsdImagingDelegate, OpenUSD 24.08's default for usdrecord/usdview,
+//    seen by the prims through scene-index emulation): the UsdPrim itself (HdVolPhoton_FindUsdPrim),
+//    read exactly as the usd-core front end reads it;
 //  * the scene-index path: the primvars HdVolPhotonMediumAPIAdapter publishes (every volphoton:*
 //    attribute, plus volphoton:__lobes, volphoton:__stageUp and volphoton:__authored).
 #ifndef HDVOLPHOTON_MEDIUM_PARAMS_H
@@ -45,8 +46,9 @@ HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTime
 std::optional<volphoton::translate::MediumParams> HdVolPhoton_ReadMedium(HdSceneDelegate *sceneDelegate, SdfPath const &id,
                                                                          bool isVolume, bool hasDensityField);
 
-/// The UsdPrim behind rprim/sprim `id` when the scene delegate is the legacy UsdImagingDelegate
-/// (invalid otherwise), and the time it renders.
+/// The UsdPrim behind rprim `id` when it was inserted by the legacy UsdImagingDelegate (directly or
+/// through scene-index emulation; HdRenderIndex::GetSceneDelegateForRprim), invalid otherwise, and
+/// the time that delegate renders.
 UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sceneDelegate, SdfPath const &id, UsdTimeCode *time = nullptr);
 
 /// Sends translation diagnostics to the Tf diagnostic system ("hdVolPhoton: error: /prim.attr: ...").

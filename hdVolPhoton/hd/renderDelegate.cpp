@@ -102,7 +102,7 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     for (volphoton::translate::SettingInfo const &info : volphoton::translate::renderSettingsTable()) {
         VtValue v = GetRenderSetting(TfToken(info.hydraKey));
         if (v.IsEmpty()) continue;
-        volphoton::translate::applySetting(s, info.name, HdVolPhoton_ToAttrValue(v), diagnostics, "render setting");
+        volphoton::translate::applySetting(s, info.name, HdVolPhoton_ToAttrValue(v), diagnostics, "render settings");
     }
     HdVolPhoton_Report(diagnostics);
     // usdrecord hides domes from the camera unless --enableDomeLightVisibility; usdview shows them.

@@ -185,5 +185,5 @@ def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
     assert np.array_equal(images["default"], images["same"])
     assert np.array_equal(images["default"], images["asdouble"])
     assert not np.array_equal(images["default"], images["independent"])
-    assert "volphoton:radiusAlpha = 7 is outside" in logs["badalpha"], logs["badalpha"]
+    assert "volphoton:radiusAlpha: radiusAlpha = 7 is outside [1e-06, 1]; clamped to 1" in logs["badalpha"], logs["badalpha"]
     assert np.isfinite(images["badalpha"]).all() and abs(images["badalpha"].mean() - 1) < 0.1
