@@ -4,6 +4,7 @@
 
 #include "core/exponentialMedium.h"
 #include "core/gridMedium.h"
+#include "core/vdbGuard.h"
 
 #include <sstream>
 
@@ -180,6 +181,13 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera) co
                 if (cached != _gridCache.end()) {
                     medium = cached->second;
                 } else {
+                    // The reader guard (core/vdbGuard.h): a file that would crash or hang the reader
+                    // is probed in a separate process and skipped here, not loaded into the host.
+                    if (std::optional<std::string> problem = vdbCrashCheck(g)) {
+                        TF_WARN("%s.filePath: field:density of %s (file %s): %s; volume skipped",
+                                rec.fields.at("density").GetText(), id.GetText(), g.filePath.c_str(), problem->c_str());
+                        continue;
+                    }
                     medium = loadGridMedium(g);
                     _gridCache[key.str()] = medium;
                 }

@@ -726,4 +726,5 @@ PYBIND11_MODULE(_core, m) {
     volphoton::bindings::registerImage(m);
     volphoton::bindings::registerVdbTestHelpers(m);
     volphoton::bindings::registerGltf(m);
+    volphoton::bindings::bindVdbGuard(m);
 }

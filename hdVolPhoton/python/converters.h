@@ -109,5 +109,6 @@ namespace volphoton::bindings {
 void registerImage(pybind11::module_& m);
 void registerVdbTestHelpers(pybind11::module_& m);
 void registerGltf(pybind11::module_& m);
+void bindVdbGuard(pybind11::module_& m);  // vdbGuardBindings.cpp
 
 }  // namespace volphoton::bindings

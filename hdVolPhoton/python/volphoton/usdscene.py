@@ -944,7 +944,7 @@ class _Translator:
         gd.phase = phase_to_core(md.phase)
         gd.object_to_world = world
         gd.max_active_voxels = self.max_grid_voxels
-        problem = vdbguard.crash_check(gd.file_path, gd.density_grid)
+        problem = vdbguard.crash_check_medium(gd)
         if problem:
             self.d.error(dens.prim_path, "filePath", "field:density of %s (file %s): %s; volume skipped"
                          % (path, dens.file_path, problem))
