@@ -210,3 +210,20 @@ TEST(VdbGuard, ConcurrentChecksAgree) {
     EXPECT_GE(runs, 4u);
     EXPECT_LE(runs, 32u);
 }
+
+TEST(VdbGuard, ARealFileThatCrashesTheReaderIsReported) {
+    // The 16^3 procedural cloud with one byte of its compressed voxel data changed: OpenVDB 10's
+    // reader corrupts its heap on it and the probe aborts (loaded in this process it throws a
+    // clean-looking error and the process may crash later). Found by byte-flip fuzzing.
+    GuardFixture guard("");
+    std::string path = testDir() + "/crash.vdb";
+    writeProceduralCloudVdb(path, 16, 1.0 / 16, 1);
+    std::string bytes = readFile(path);
+    ASSERT_EQ(bytes.size(), 15650u) << "the procedural cloud changed: find another crashing byte";
+    ASSERT_EQ(bytes[9036], '\0');
+    bytes[9036] = char(26);
+    writeFile(path, bytes);
+    std::optional<std::string> problem = vdbCrashCheck(path, "density");
+    ASSERT_TRUE(problem.has_value()) << "the file no longer crashes the reader (another OpenVDB?)";
+    EXPECT_NE(problem->find("crashed on this file (SIG"), std::string::npos) << *problem;
+}
