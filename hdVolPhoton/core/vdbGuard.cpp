@@ -103,8 +103,9 @@ const std::string& bundledProbePath() {
     return path;
 }
 
-/// Runs `argv` (argv[0] = the executable) with stdin, stdout and stderr on /dev/null, the host's
-/// environment, an empty signal mask and default signal actions; kills it at the deadline.
+/// Runs `args` (args[0] = the executable) with stdin, stdout and stderr on /dev/null and no other
+/// descriptor, the host's environment, an empty signal mask and default signal actions; kills it at
+/// the deadline.
 ProbeOutcome runProbe(const std::vector<std::string>& args, double timeoutSeconds) {
     ProbeOutcome outcome;
     std::vector<char*> argv;
@@ -116,6 +117,10 @@ ProbeOutcome runProbe(const std::vector<std::string>& args, double timeoutSecond
     posix_spawn_file_actions_addopen(&files, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
     posix_spawn_file_actions_adddup2(&files, 1, 2);
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 34))
+    // The host's other descriptors (pipes a caller reads to EOF, sockets) stay the host's.
+    posix_spawn_file_actions_addclosefrom_np(&files, 3);
+#endif
     posix_spawnattr_t attr;
     posix_spawnattr_init(&attr);
     sigset_t none, all;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -226,4 +228,25 @@ TEST(VdbGuard, ARealFileThatCrashesTheReaderIsReported) {
     std::optional<std::string> problem = vdbCrashCheck(path, "density");
     ASSERT_TRUE(problem.has_value()) << "the file no longer crashes the reader (another OpenVDB?)";
     EXPECT_NE(problem->find("crashed on this file (SIG"), std::string::npos) << *problem;
+}
+
+TEST(VdbGuard, TheProbeInheritsNoDescriptorButTheStandardOnes) {
+    // A host's pipe (inheritable: no O_CLOEXEC) must not stay open in a probe that hangs until its
+    // time-out, or a caller reading that pipe to its end would wait for the probe too.
+    std::string dir = testDir();
+    GuardFixture guard(stubProbe(dir, "fds", "ls /proc/$$/fd > '" + dir + "/fds.txt'"));
+    int ends[2];
+    ASSERT_EQ(::pipe(ends), 0);
+    ASSERT_EQ(::dup2(ends[0], 57), 57);
+    ASSERT_EQ(::dup2(ends[1], 58), 58);
+    writeFile(dir + "/f.vdb", "x");
+    EXPECT_EQ(vdbCrashCheck(dir + "/f.vdb", "density"), std::nullopt);
+    for (int fd : {ends[0], ends[1], 57, 58}) ::close(fd);
+    std::string text = readFile(dir + "/fds.txt");
+    std::set<std::string> open;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) open.insert(line);
+    ASSERT_TRUE(open.count("0") && open.count("1") && open.count("2")) << text;
+    EXPECT_EQ(open.count("57"), 0u) << text;
+    EXPECT_EQ(open.count("58"), 0u) << text;
 }
