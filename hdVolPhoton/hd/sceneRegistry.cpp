@@ -5,6 +5,7 @@
 #include "core/exponentialMedium.h"
 #include "core/translate/medium.h"
 #include "core/gridMedium.h"
+#include "core/vdbGuard.h"
 
 #include <sstream>
 
@@ -91,6 +92,14 @@ MediumPtr HdVolPhoton_SceneRegistry::_GridMedium(SdfPath const &id, HdVolPhoton_
         for (int c = 0; c < 4; ++c) key << g.objectToWorld.m[r][c] << ',';
     auto cached = _gridCache.find(key.str());
     if (cached != _gridCache.end()) return cached->second;
+    // The reader guard (core/vdbGuard.h): a file that would crash or hang the reader is probed in a
+    // separate process and skipped here, not loaded into the host (as the usd-core front end does).
+    if (std::optional<std::string> problem = vdbCrashCheck(g)) {
+        diagnostics.error(density->primPath.empty() ? id.GetString() : density->primPath, "filePath",
+                          "field:density of " + id.GetString() + " (file " + g.filePath + "): " + *problem +
+                              "; volume skipped");
+        return nullptr;
+    }
     try {
         MediumPtr medium = loadGridMedium(g);
         _gridCache[key.str()] = medium;

@@ -728,4 +728,5 @@ PYBIND11_MODULE(_core, m) {
     volphoton::bindings::registerVdbTestHelpers(m);
     volphoton::bindings::registerGltf(m);
     volphoton::bindings::registerTranslate(m);
+    volphoton::bindings::bindVdbGuard(m);
 }

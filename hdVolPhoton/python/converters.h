@@ -110,5 +110,6 @@ void registerImage(pybind11::module_& m);
 void registerVdbTestHelpers(pybind11::module_& m);
 void registerGltf(pybind11::module_& m);
 void registerTranslate(pybind11::module_& m);
+void bindVdbGuard(pybind11::module_& m);  // vdbGuardBindings.cpp
 
 }  // namespace volphoton::bindings

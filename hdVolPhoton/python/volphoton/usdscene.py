@@ -864,7 +864,7 @@ class _Translator:
                 continue
             setattr(gd, attr, f.field_name or fname)
         gd.max_active_voxels = self.max_grid_voxels
-        problem = vdbguard.crash_check(gd.file_path, gd.density_grid)
+        problem = vdbguard.crash_check_medium(gd)
         if problem:
             self.d.error(dens.prim_path, "filePath", "field:density of %s (file %s): %s; volume skipped"
                          % (path, dens.file_path, problem))
