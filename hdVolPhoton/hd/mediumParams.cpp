@@ -83,17 +83,47 @@ AttrValue HdVolPhoton_ToAttrValue(VtValue const &v) {
     return translate::Unusable{v.GetTypeName()};
 }
 
-UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sd, SdfPath const &id, UsdTimeCode *time) {
-    if (!sd || id.IsEmpty()) return UsdPrim();
+namespace {
+UsdImagingDelegate *_LegacyDelegate(HdSceneDelegate *sd, SdfPath const &id) {
+    if (!sd || id.IsEmpty()) return nullptr;
     // With scene-index emulation (OpenUSD's default) the prims see HdSceneIndexAdapterSceneDelegate;
     // the render index still answers with the UsdImagingDelegate that inserted the rprim.
     auto *usd = dynamic_cast<UsdImagingDelegate *>(sd);
-    if (!usd) usd = dynamic_cast<UsdImagingDelegate *>(sd->GetRenderIndex().GetSceneDelegateForRprim(id));
-    if (!usd) return UsdPrim();
+    return usd ? usd : dynamic_cast<UsdImagingDelegate *>(sd->GetRenderIndex().GetSceneDelegateForRprim(id));
+}
+
+UsdPrim _PrimOf(UsdImagingDelegate *usd, SdfPath const &id) {
     _PrimAccess access;
     access.SetDelegate(usd);
-    if (time) *time = usd->GetTime();
     return access.Prim(usd->GetScenePrimPath(id, 0, nullptr));
+}
+
+bool _MightVaryInTime(UsdPrim const &prim) {
+    for (UsdAttribute const &attr : prim.GetAttributes())
+        if (TfStringStartsWith(attr.GetName().GetString(), "volphoton:") && attr.ValueMightBeTimeVarying()) return true;
+    return false;
+}
+}  // namespace
+
+UsdPrim HdVolPhoton_FindUsdPrim(HdSceneDelegate *sd, SdfPath const &id, UsdTimeCode *time) {
+    UsdImagingDelegate *usd = _LegacyDelegate(sd, id);
+    if (!usd) return UsdPrim();
+    if (time) *time = usd->GetTime();
+    return _PrimOf(usd, id);
+}
+
+bool HdVolPhoton_MediumSource::IsStale() const { return delegate && delegate->GetTime() != time; }
+
+std::optional<translate::MediumParams> HdVolPhoton_RereadMedium(HdVolPhoton_MediumSource &source) {
+    source.time = source.delegate->GetTime();
+    UsdPrim prim = _PrimOf(source.delegate, source.id);
+    if (!prim) return std::nullopt;
+    HdVolPhoton_MediumInput in = HdVolPhoton_ReadMediumInput(prim, source.time);
+    in.context.hasDensityField = source.hasDensityField;
+    translate::Diagnostics diagnostics;
+    std::optional<translate::MediumParams> params = translate::readMedium(in.record, in.context, diagnostics);
+    HdVolPhoton_Report(diagnostics);
+    return params;
 }
 
 HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTimeCode time) {
@@ -122,11 +152,14 @@ HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTime
 }
 
 std::optional<translate::MediumParams> HdVolPhoton_ReadMedium(HdSceneDelegate *sd, SdfPath const &id, bool isVolume,
-                                                              bool hasDensityField) {
+                                                              bool hasDensityField, HdVolPhoton_MediumSource *source) {
     UsdTimeCode time = UsdTimeCode::Default();
     HdVolPhoton_MediumInput in;
+    if (source) *source = HdVolPhoton_MediumSource();
     if (UsdPrim prim = HdVolPhoton_FindUsdPrim(sd, id, &time)) {
         in = HdVolPhoton_ReadMediumInput(prim, time);
+        if (source && _MightVaryInTime(prim))
+            *source = HdVolPhoton_MediumSource{_LegacyDelegate(sd, id), id, isVolume, hasDensityField, time};
     } else {
         // Scene-index path: the primvars of HdVolPhotonMediumAPIAdapter (present when the API is applied).
         in.record.primPath = id.GetString();

@@ -24,6 +24,7 @@
 PXR_NAMESPACE_OPEN_SCOPE
 
 class HdSceneDelegate;
+class UsdImagingDelegate;
 
 /// The extra primvars the scene-index adapter publishes beside the attributes.
 #define HDVOLPHOTON_MEDIUM_LOBES "volphoton:__lobes"
@@ -41,10 +42,29 @@ struct HdVolPhoton_MediumInput {
 };
 HdVolPhoton_MediumInput HdVolPhoton_ReadMediumInput(UsdPrim const &prim, UsdTimeCode time);
 
+/// Where a medium read through the legacy UsdImagingDelegate came from, kept when any of its
+/// volphoton:* attributes may vary in time: UsdImaging does not track the variability of attributes
+/// it does not know, so a time change would not re-sync the prim. The render pass re-reads such
+/// media when the delegate's time moves (HdVolPhoton_SceneRegistry::RefreshTimeVaryingMedia).
+struct HdVolPhoton_MediumSource {
+    UsdImagingDelegate *delegate = nullptr;
+    SdfPath id;
+    bool isVolume = false;
+    bool hasDensityField = false;
+    UsdTimeCode time;
+    /// True when the delegate now renders another time than the one read.
+    bool IsStale() const;
+};
+
 /// The validated medium of rprim `id` (a Volume when isVolume, else a Gprim), or nullopt when it is
-/// not a medium. Diagnostics become TF_WARNs naming prim and attribute.
+/// not a medium. Diagnostics become TF_WARNs naming prim and attribute. `source` (optional) is set
+/// when the medium may vary in time (its delegate is null otherwise).
 std::optional<volphoton::translate::MediumParams> HdVolPhoton_ReadMedium(HdSceneDelegate *sceneDelegate, SdfPath const &id,
-                                                                         bool isVolume, bool hasDensityField);
+                                                                         bool isVolume, bool hasDensityField,
+                                                                         HdVolPhoton_MediumSource *source = nullptr);
+
+/// Reads the medium of `source` again at its delegate's current time (and updates source.time).
+std::optional<volphoton::translate::MediumParams> HdVolPhoton_RereadMedium(HdVolPhoton_MediumSource &source);
 
 /// The UsdPrim behind rprim `id` when it was inserted by the legacy UsdImagingDelegate (directly or
 /// through scene-index emulation; HdRenderIndex::GetSceneDelegateForRprim), invalid otherwise, and

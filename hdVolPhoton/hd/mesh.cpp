@@ -92,7 +92,8 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
     //      end only; the delegate uses displayColor.
 
     rec.materialId = sceneDelegate->GetMaterialId(id);
-    if (auto medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/false, /*hasDensityField=*/false)) {
+    if (auto medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/false, /*hasDensityField=*/false,
+                                             &rec.mediumSource)) {
         rec.hasMedium = true;
         rec.medium = *medium;
     }

@@ -38,6 +38,10 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
     if (width <= 0 || height <= 0) return;
     GfMatrix4d view = state->GetWorldToViewMatrix(), proj = state->GetProjectionMatrix();
     HdRenderPassAovBindingVector const &aovs = state->GetAovBindings();
+    // Media with time-varying volphoton:* attributes follow the scene delegate's time (UsdImaging
+    // does not re-sync them): re-read them through the edit gate, which restarts the render.
+    auto *renderParam = static_cast<HdVolPhotonRenderParam *>(_delegate->GetRenderParam());
+    if (renderParam->GetRegistry().HasStaleMedia()) renderParam->AcquireSceneForEdit().RefreshTimeVaryingMedia();
     int version = _sceneVersion->load();
     unsigned int settingsVersion = _delegate->GetRenderSettingsVersion();
     bool aovsChanged = aovs.size() != _aovBindings.size();

@@ -42,6 +42,28 @@ void HdVolPhoton_SceneRegistry::Remove(SdfPath const &id) {
     _fields.erase(id);
     _lights.erase(id);
 }
+bool HdVolPhoton_SceneRegistry::HasStaleMedia() const {
+    std::lock_guard<std::mutex> lock(_mutex);
+    for (auto const &[id, rec] : _meshes)
+        if (rec.mediumSource.IsStale()) return true;
+    for (auto const &[id, rec] : _volumes)
+        if (rec.mediumSource.IsStale()) return true;
+    return false;
+}
+
+void HdVolPhoton_SceneRegistry::RefreshTimeVaryingMedia() {
+    std::lock_guard<std::mutex> lock(_mutex);
+    for (auto &[id, rec] : _meshes)
+        if (rec.mediumSource.IsStale()) {
+            auto medium = HdVolPhoton_RereadMedium(rec.mediumSource);
+            rec.hasMedium = medium.has_value();
+            if (medium) rec.medium = *medium;
+        }
+    for (auto &[id, rec] : _volumes)
+        if (rec.mediumSource.IsStale())
+            rec.medium = HdVolPhoton_RereadMedium(rec.mediumSource).value_or(volphoton::translate::MediumParams());
+}
+
 size_t HdVolPhoton_SceneRegistry::GetMeshCount() const {
     std::lock_guard<std::mutex> lock(_mutex);
     return _meshes.size();

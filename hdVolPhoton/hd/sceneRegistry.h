@@ -30,6 +30,7 @@ struct HdVolPhoton_MeshRecord {
     int primId = -1;  ///< HdRprim::GetPrimId(): what the primId AOV reports (instanceId: index into instances)
     bool hasMedium = false;
     volphoton::translate::MediumParams medium;
+    HdVolPhoton_MediumSource mediumSource;  ///< set when the medium may vary in time (legacy path)
     SdfPath materialId;  ///< bound material of the faces in no subset
     std::vector<HdVolPhoton_SubsetRecord> subsets;
 };
@@ -52,6 +53,7 @@ struct HdVolPhoton_FieldRecord {
 /// (density, temperature, emission, albedo).
 struct HdVolPhoton_VolumeRecord {
     volphoton::translate::MediumParams medium;
+    HdVolPhoton_MediumSource mediumSource;  ///< set when the medium may vary in time (legacy path)
     volphoton::Affine objectToWorld;
     std::map<std::string, SdfPath> fields;
 };
@@ -76,6 +78,12 @@ public:
     /// and the prim is left out; the rest still renders.
     /// maxGridVoxels: the grid-size cap (RenderSettings::maxGridVoxels).
     volphoton::SceneDesc BuildSceneDesc(volphoton::CameraDesc const &camera, std::uint64_t maxGridVoxels) const;
+
+    /// True when a medium whose attributes vary in time was read at another time than its scene
+    /// delegate now renders (UsdImaging would not re-sync it: see HdVolPhoton_MediumSource).
+    bool HasStaleMedia() const;
+    /// Re-reads those media (call through the edit gate, which restarts the render).
+    void RefreshTimeVaryingMedia();
 
     /// Counts for render stats.
     size_t GetMeshCount() const;

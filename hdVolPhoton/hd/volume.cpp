@@ -47,7 +47,8 @@ void HdVolPhotonVolume::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *rend
         rec.fields[f.fieldName.GetString()] = f.fieldId;
     }
     // A Volume is always a medium (schema defaults without the API).
-    rec.medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/true, rec.fields.count("density") > 0)
+    rec.medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/true, rec.fields.count("density") > 0,
+                                        &rec.mediumSource)
                      .value_or(volphoton::translate::MediumParams());
     registry.SetVolume(id, std::move(rec));
     *dirtyBits &= ~HdChangeTracker::AllSceneDirtyBits;
