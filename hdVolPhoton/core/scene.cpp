@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/diagnostics.h"
+#include "core/mediumAggregate.h"
 
 namespace volphoton {
 
@@ -117,6 +118,21 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     for (const auto& m : desc_.media) emissiveMedia_ |= m->isEmissive();
     hasMedia_ = !desc_.unboundedMedia.empty();
     for (const auto& m : desc_.meshes) hasMedia_ |= m.interiorMedium >= 0;
+    {
+        // A point is in at most MediumAggregate::MaxMedia media (all unbounded media plus the
+        // innermost closed mesh's): say so rather than drop the rest silently.
+        size_t unbounded = desc_.unboundedMedia.size();
+        bool meshMedia = false;
+        for (const MeshDesc& m : desc_.meshes) meshMedia |= m.interiorMedium >= 0;
+        if (unbounded > size_t(MediumAggregate::MaxMedia) || (meshMedia && unbounded >= size_t(MediumAggregate::MaxMedia))) {
+            std::ostringstream msg;
+            msg << "the scene has " << unbounded << " volumes/unbounded media" << (meshMedia ? " and media inside meshes" : "")
+                << ", but at most " << MediumAggregate::MaxMedia
+                << " media are rendered at any point (all volumes plus the innermost mesh's medium); the media after the "
+                << (meshMedia ? MediumAggregate::MaxMedia - 1 : MediumAggregate::MaxMedia) << "th are ignored";
+            warn(msg.str());
+        }
+    }
 #ifdef VOLPHOTON_NO_VOLUMES
     if (hasMedia_) warn("this core is built with VOLPHOTON_NO_VOLUMES: the scene's media are ignored");
     hasMedia_ = emissiveMedia_ = false;

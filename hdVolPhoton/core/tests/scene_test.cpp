@@ -2,7 +2,9 @@
 // conservation, instancing, nested media, the camera inside a closed medium.
 #include <gtest/gtest.h>
 
+#include "core/diagnostics.h"
 #include "core/homogeneousMedium.h"
+#include "core/mediumAggregate.h"
 #include "core/integratorBase.h"
 #include "tests/renderTestUtil.h"
 #include "tests/testUtil.h"
@@ -295,4 +297,21 @@ TEST(SceneMedia, OpenMeshMediumIsCutAtItsBoundsNotInfinite) {
         // A non-absorbing-ish fog in a dome: the image is bright, not black from lost paths.
         EXPECT_GT(sum / (16 * 16 * 3), 0.5);
     }
+}
+
+TEST(Scene, WarnsWhenMoreMediaOverlapThanAreRendered) {
+    using namespace volphoton;
+    std::vector<std::string> messages;
+    setDiagnosticSink([&](Severity, const std::string& m) { messages.push_back(m); });
+    SceneDesc d;
+    for (int i = 0; i < MediumAggregate::MaxMedia + 1; ++i) {
+        d.media.push_back(std::make_shared<HomogeneousMedium>(
+            MediumCoefficients::fromAlbedo(0.1, Spectrum(1.0), Spectrum(0.5), Spectrum(0.0), makeIsotropicPhase())));
+        d.unboundedMedia.push_back(i);
+    }
+    Scene scene(d);
+    setDiagnosticSink({});
+    bool warned = false;
+    for (const std::string& m : messages) warned |= m.find("are ignored") != std::string::npos;
+    EXPECT_TRUE(warned);
 }
