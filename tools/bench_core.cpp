@@ -19,6 +19,7 @@
 #include "core/gridMedium.h"
 #include "core/homogeneousMedium.h"
 #include "core/mediumAggregate.h"
+#include "core/proceduralCloud.h"
 #include "core/sampling.h"
 #include "core/transmittance.h"
 

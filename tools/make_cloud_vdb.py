@@ -4,7 +4,7 @@
     python tools/make_cloud_vdb.py testenv/cloud.vdb            # 64^3 voxels, about 0.3 MB
     python tools/make_cloud_vdb.py out.vdb --resolution 128 --voxel-size 0.0078125 --seed 7
 
-The cloud is the core's ``writeProceduralCloudVdb`` (gridMedium.h): a FloatGrid named "density",
+The cloud is the core's ``writeProceduralCloudVdb`` (proceduralCloud.h): a FloatGrid named "density",
 values in [0, 1], a fractal-noise blob inside a sphere of radius 0.45 * resolution voxels, in the
 box [0, resolution * voxel_size]^3 of its object space (with the defaults the unit cube). The same
 arguments give the same file on every machine. The .vdb is generated, not kept in git: the tests

@@ -9,7 +9,7 @@ tools/make_subsurface_meshes.py (3.4 cm tall, closed, with normals) and, 2 cm be
 6 x 1.5 x 2 cm block whose top and sides are two primitives with two materials (-> GeomSubsets).
 Node tree: Statue -> {figure (TRS), pedestal (matrix)}.  (The block is not under the figure: a
 surface within a few millimetres of a medium's mesh can confuse the photon tracer's medium
-bookkeeping; see the XXX in tools/bench/README.md.)  Deterministic output.
+bookkeeping.)  Deterministic output.
 
     python tools/make_gltf_assets.py --triangles 1000000 OUT.glb
 writes a single-mesh asset of about that many triangles (a displaced sphere) for the conversion

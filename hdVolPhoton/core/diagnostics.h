@@ -16,5 +16,7 @@ using DiagnosticSink = std::function<void(Severity, const std::string&)>;
 void setDiagnosticSink(DiagnosticSink sink);
 void report(Severity severity, const std::string& message);
 inline void warn(const std::string& message) { report(Severity::Warning, message); }
+/// `s` in single quotes: how a message names a file, grid or prim.
+inline std::string quote(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace volphoton

@@ -2,25 +2,21 @@
 
 #include <atomic>
 #include <chrono>
-#include <filesystem>
-#include <fstream>
-#include <mutex>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
 #include <vector>
 
-#include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "core/blackbody.h"
 #include "core/diagnostics.h"
 #include "core/majorantGrid.h"
-#include "core/rng.h"
+#include "core/vdbFile.h"
 
 namespace volphoton {
 
@@ -34,72 +30,6 @@ namespace {
 /// default (safe) accessor, a concurrent hash map insertion per construction, buys nothing.
 using ConstAccessor = openvdb::tree::ValueAccessor<const FloatTree, /*IsSafe=*/false>;
 using LeafT = FloatTree::LeafNodeType;
-
-void initOpenVdb() {
-    static std::once_flag once;
-    std::call_once(once, [] { openvdb::initialize(); });
-}
-
-/// Thrown by this file with a complete message; the loader rethrows it unchanged and wraps any other
-/// exception (OpenVDB's, std::bad_alloc, stream failures) with the file and grid it was reading.
-struct GridLoadError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
-
-// ---- blackbody ---------------------------------------------------------------------------------
-
-/// Wyman, Sloan and Shirley 2013, multi-lobe fit: g(x; mu, s1, s2) with s1 left of mu, s2 right.
-double piecewiseGaussian(double x, double mu, double s1, double s2) {
-    double t = (x - mu) / (x < mu ? s1 : s2);
-    return std::exp(-0.5 * t * t);
-}
-
-Spectrum blackbodyColorExact(double T) {
-    // Planck: B(l, T) ~ l^-5 / (exp(c2 / (l T)) - 1), c2 = hc/k in nm K. Only the chromaticity is
-    // kept, so constant factors drop out; exp(-(x - x0)) keeps the numbers in range at low T.
-    const double c2 = 1.4387769e7;
-    const double x0 = c2 / (830.0 * T);
-    double X = 0, Y = 0, Z = 0;
-    for (double l = 360.0; l <= 830.0; l += 1.0) {
-        double x = c2 / (l * T);
-        double b = std::pow(l / 560.0, -5.0) * std::exp(-(x - x0)) / -std::expm1(-x);
-        double xb = 1.056 * piecewiseGaussian(l, 599.8, 37.9, 31.0) + 0.362 * piecewiseGaussian(l, 442.0, 16.0, 26.7) -
-                    0.065 * piecewiseGaussian(l, 501.1, 20.4, 26.2);
-        double yb = 0.821 * piecewiseGaussian(l, 568.8, 46.9, 40.5) + 0.286 * piecewiseGaussian(l, 530.9, 16.3, 31.1);
-        double zb = 1.217 * piecewiseGaussian(l, 437.0, 11.8, 36.0) + 0.681 * piecewiseGaussian(l, 459.0, 26.0, 13.8);
-        X += b * xb;
-        Y += b * yb;
-        Z += b * zb;
-    }
-    // XYZ -> linear sRGB (Rec.709 primaries, D65 white).
-    Spectrum rgb(3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z, -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z,
-                 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z);
-    for (int i = 0; i < 3; ++i) rgb[i] = std::max(0.0, rgb[i]);
-    double lum = luminance(rgb);
-    return lum > 0 ? rgb / lum : Spectrum(0.0);
-}
-
-struct BlackbodyTable {
-    static constexpr int N = 512;
-    static constexpr double TMin = 300.0, TMax = 50000.0;
-    Spectrum c[N];
-    BlackbodyTable() {
-        for (int i = 0; i < N; ++i) c[i] = blackbodyColorExact(TMin * std::pow(TMax / TMin, double(i) / (N - 1)));
-    }
-    Spectrum lookup(double T) const {
-        double u = std::log(std::clamp(T, TMin, TMax) / TMin) / std::log(TMax / TMin) * (N - 1);
-        int i = std::min(static_cast<int>(u), N - 2);
-        double f = u - i;
-        return c[i] * (1 - f) + c[i + 1] * f;
-    }
-};
-
-const BlackbodyTable& blackbodyTable() {
-    static const BlackbodyTable table;
-    return table;
-}
 
 // ---- transforms --------------------------------------------------------------------------------
 
@@ -116,8 +46,6 @@ Affine indexToObject(const openvdb::math::Transform& xf) {
 }
 
 // ---- trilinear sampling ------------------------------------------------------------------------
-
-inline double lerp(double a, double b, double t) { return a + (b - a) * t; }
 
 /// Trilinear interpolation of the values at integer index coordinates (voxel centres).
 double sampleTrilinear(ConstAccessor& acc, const Vec3& p) {
@@ -146,8 +74,7 @@ double sampleTrilinear(ConstAccessor& acc, const Vec3& p) {
     } else {
         for (int k = 0; k < 8; ++k) s[k] = acc.getValue(Coord(ix + (k >> 2), iy + ((k >> 1) & 1), iz + (k & 1)));
     }
-    double x00 = lerp(s[0], s[4], u), x01 = lerp(s[1], s[5], u), x10 = lerp(s[2], s[6], u), x11 = lerp(s[3], s[7], u);
-    return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w);
+    return trilinear(s, u, v, w);
 }
 
 // ---- sanitising --------------------------------------------------------------------------------
@@ -312,19 +239,6 @@ std::atomic<uint64_t> nextMediumId{1};
 
 }  // namespace
 
-// ---- public blackbody helpers ------------------------------------------------------------------
-
-Spectrum blackbodyColor(double kelvin) {
-    if (!(kelvin > 0)) return Spectrum(0.0);
-    return blackbodyTable().lookup(kelvin);
-}
-
-Spectrum blackbodyRadiance(double kelvin) {
-    if (!(kelvin > 0) || !std::isfinite(kelvin)) return Spectrum(0.0);
-    double t = kelvin / 1000.0;
-    return blackbodyColor(kelvin) * (t * t * t * t);
-}
-
 // ---- GridMedium --------------------------------------------------------------------------------
 
 struct GridMedium::Impl {
@@ -430,9 +344,9 @@ GridMedium::GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids,
              std::to_string(desc.albedo[1]) + ", " + std::to_string(desc.albedo[2]) + ") clamped to [0, 1]");
 
     if (!desc.objectToWorld.isFinite())
-        throw GridLoadError("grid medium " + quote(m.source) + ": objectToWorld has non-finite entries");
+        throw std::runtime_error("grid medium " + quote(m.source) + ": objectToWorld has non-finite entries");
     if (!desc.objectToWorld.inverse())
-        throw GridLoadError("grid medium " + quote(m.source) + ": objectToWorld is not invertible");
+        throw std::runtime_error("grid medium " + quote(m.source) + ": objectToWorld is not invertible");
 
     const std::shared_ptr<const openvdb::GridBase>* in[FieldCount] = {&grids.density, &grids.temperature,
                                                                         &grids.emission, &grids.albedo};
@@ -440,7 +354,7 @@ GridMedium::GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids,
                                             &desc.albedoGrid};
     const char* roles[FieldCount] = {"density", "temperature", "emission", "albedo"};
     if (!grids.density)
-        throw GridLoadError("grid medium " + quote(m.source) + ": no density grid given");
+        throw std::runtime_error("grid medium " + quote(m.source) + ": no density grid given");
 
     for (int f = 0; f < FieldCount; ++f) {
         const auto& base = *in[f];
@@ -450,15 +364,15 @@ GridMedium::GridMedium(const GridMediumDesc& desc, const GridMediumGrids& grids,
         const std::string where = "grid " + quote(field.name) + " (" + roles[f] + ") of " + quote(m.source);
         auto grid = openvdb::GridBase::constGrid<FloatGrid>(base);
         if (!grid)
-            throw GridLoadError(where + " has value type " + base->valueType() + " (grid type " + base->type() +
+            throw std::runtime_error(where + " has value type " + base->valueType() + " (grid type " + base->type() +
                                 "), but a float grid (FloatGrid) is required");
         const openvdb::math::Transform& xf = grid->transform();
         if (!xf.isLinear())
-            throw GridLoadError(where + " has a non-linear (" + xf.mapType() +
+            throw std::runtime_error(where + " has a non-linear (" + xf.mapType() +
                                 ") transform; only linear (affine) grid transforms are supported");
         Affine toWorld = desc.objectToWorld * indexToObject(xf);
         std::optional<Affine> toIndex = toWorld.inverse();
-        if (!toIndex) throw GridLoadError(where + ": index-to-world transform is not invertible");
+        if (!toIndex) throw std::runtime_error(where + ": index-to-world transform is not invertible");
         field.indexToWorld = toWorld;
         field.worldToIndex = *toIndex;
 
@@ -635,298 +549,24 @@ double GridMedium::majorantBuildSeconds() const { return impl_->majorantSeconds;
 const Affine& GridMedium::worldToIndex() const { return impl_->fields[DensityField].worldToIndex; }
 const Affine& GridMedium::indexToWorld() const { return impl_->fields[DensityField].indexToWorld; }
 
-// ---- loading -----------------------------------------------------------------------------------
-
-namespace {
-
-/// Bounded little-endian reader over a file: every read is checked against the file size first.
-class CheckedReader {
-public:
-    CheckedReader(const std::string& path, uint64_t size) : in_(path, std::ios::binary), size_(size) {}
-    bool ok() const { return static_cast<bool>(in_); }
-    uint64_t pos() const { return pos_; }
-    uint64_t remaining() const { return size_ - pos_; }
-    template <typename T>
-    T read(const char* what) {
-        T v{};
-        need(sizeof(T), what);
-        in_.read(reinterpret_cast<char*>(&v), sizeof(T));
-        advance(sizeof(T), what);
-        return v;
-    }
-    void skip(uint64_t n, const char* what) {
-        need(n, what);
-        in_.seekg(static_cast<std::streamoff>(pos_ + n));
-        advance(n, what);
-    }
-    std::string readString(const char* what) {
-        uint32_t n = read<uint32_t>(what);
-        need(n, what);
-        std::string s(n, '\0');
-        if (n) in_.read(&s[0], n);
-        advance(n, what);
-        return s;
-    }
-    void seek(uint64_t p, const char* what) {
-        if (p > size_) fail(std::string(what) + " points past the end of the file");
-        in_.seekg(static_cast<std::streamoff>(p));
-        pos_ = p;
-        if (!in_) fail(std::string("cannot seek to ") + what);
-    }
-    [[noreturn]] static void fail(const std::string& why) { throw GridLoadError(why); }
-
-private:
-    void need(uint64_t n, const char* what) {
-        if (n > remaining()) fail(std::string("the file ends inside the ") + what);
-    }
-    void advance(uint64_t n, const char* what) {
-        if (!in_) fail(std::string("cannot read the ") + what);
-        pos_ += n;
-    }
-    std::ifstream in_;
-    uint64_t size_, pos_ = 0;
-};
-
-/// Walks the VDB header, file metadata and grid descriptors (the same way io::File::open does) with
-/// every length and offset checked against the file size. OpenVDB itself reads lengths from a failed
-/// stream as uninitialised values, so a truncated file can make it allocate gigabytes or load garbage
-/// without complaint; this catches truncation and damaged headers before OpenVDB sees the file.
-/// Throws GridLoadError with a description (the caller adds the path).
-void checkVdbStructure(const std::string& path, uint64_t size) {
-    CheckedReader r(path, size);
-    if (!r.ok()) CheckedReader::fail("cannot open the file for reading");
-    if (r.read<int64_t>("header") != openvdb::OPENVDB_MAGIC) CheckedReader::fail("not a VDB file (bad magic number)");
-    uint32_t version = r.read<uint32_t>("header");
-    if (version > openvdb::OPENVDB_FILE_VERSION)
-        CheckedReader::fail("unsupported VDB file format version " + std::to_string(version) + " (this OpenVDB reads up to " +
-                            std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")");
-    if (version < 211) {  // separate major, minor and patch numbers
-        uint32_t minor = r.read<uint32_t>("header"), patch = r.read<uint32_t>("header");
-        version = 100 * version + 10 * minor + patch;
-    } else {
-        r.skip(8, "header");  // library major and minor version
-    }
-    bool hasGridOffsets = true;
-    if (version >= 212) hasGridOffsets = r.read<char>("header") != 0;
-    if (version >= openvdb::OPENVDB_FILE_VERSION_SELECTIVE_COMPRESSION &&
-        version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION)
-        r.skip(1, "header");
-    r.skip(version >= openvdb::OPENVDB_FILE_VERSION_BOOST_UUID ? 36 : 16, "header (UUID)");
-    // A metadata map: count, then (name, type name, size-prefixed value) triples.
-    auto skipMetaMap = [&r](const char* what) {
-        uint32_t count = r.read<uint32_t>(what);
-        if (count > r.remaining()) CheckedReader::fail(std::string("the ") + what + " count is implausible");
-        for (uint32_t i = 0; i < count; ++i) {
-            r.readString(what);
-            r.readString(what);
-            r.skip(r.read<uint32_t>(what), what);
-        }
-    };
-    skipMetaMap("file metadata");
-    if (!hasGridOffsets) return;  // very old files: nothing more can be checked without reading grids
-    int32_t gridCount = r.read<int32_t>("grid count");
-    if (gridCount < 0 || static_cast<uint64_t>(gridCount) > r.remaining())
-        CheckedReader::fail("the grid count " + std::to_string(gridCount) + " is implausible");
-    for (int32_t g = 0; g < gridCount; ++g) {
-        std::string name = r.readString("grid descriptor");
-        r.readString("grid descriptor");  // type
-        if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING)
-            r.readString("grid descriptor");  // instance parent
-        int64_t gridPos = r.read<int64_t>("grid descriptor");
-        int64_t blockPos = r.read<int64_t>("grid descriptor");
-        int64_t endPos = r.read<int64_t>("grid descriptor");
-        const uint64_t here = r.pos();
-        if (gridPos < 0 || blockPos < gridPos || endPos < blockPos || static_cast<uint64_t>(gridPos) < here)
-            CheckedReader::fail("the descriptor of grid " + quote(name) + " has inconsistent offsets");
-        if (static_cast<uint64_t>(endPos) > size)
-            CheckedReader::fail("grid " + quote(name) + " ends at byte " + std::to_string(endPos) + " but the file has only " +
-                                std::to_string(size) + " bytes (truncated?)");
-        // The start of the grid itself: compression flags, grid metadata and the transform's type.
-        r.seek(static_cast<uint64_t>(gridPos), "grid start");
-        if (version >= openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) r.skip(4, "grid compression flags");
-        skipMetaMap("grid metadata");
-        if (r.pos() > static_cast<uint64_t>(endPos)) CheckedReader::fail("grid " + quote(name) + "'s metadata overruns the grid");
-        if (version >= openvdb::OPENVDB_FILE_VERSION_GRID_INSTANCING) {
-            std::string map = r.readString("grid transform");
-            if (!openvdb::math::MapRegistry::isRegistered(map))
-                CheckedReader::fail("grid " + quote(name) + " has an unknown transform type " + quote(map));
-        }
-        r.seek(static_cast<uint64_t>(endPos), "grid end");
-    }
-}
-
-}  // namespace
-
-
 std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc) {
-    initOpenVdb();
     const std::string& path = desc.filePath;
     if (path.empty()) throw std::runtime_error("grid medium: no VDB file path given");
     if (desc.densityGrid.empty())
         throw std::runtime_error("grid medium " + quote(path) + ": no density grid name given");
-    {
-        std::error_code ec;
-        auto status = std::filesystem::status(path, ec);
-        if (ec || !std::filesystem::exists(status))
-            throw std::runtime_error("cannot open VDB file " + quote(path) + ": file does not exist");
-        if (std::filesystem::is_directory(status))
-            throw std::runtime_error("cannot open VDB file " + quote(path) + ": it is a directory");
-    }
+    checkVdbPath(path);
     if (!desc.objectToWorld.isFinite())
         throw std::runtime_error("grid medium " + quote(path) + ": objectToWorld has non-finite entries");
     if (!desc.objectToWorld.inverse())
         throw std::runtime_error("grid medium " + quote(path) + ": objectToWorld is not invertible");
-
-    GridMediumGrids grids;
-    std::string reading = "header";
-    try {
-        uint64_t size = std::filesystem::file_size(path);
-        try {
-            checkVdbStructure(path, size);
-        } catch (const GridLoadError& e) {
-            throw GridLoadError("cannot read VDB file " + quote(path) + ": the file is corrupt or truncated: " + e.what());
-        }
-        openvdb::io::File file(path);
-        // No delayed loading: the medium owns all of its data and never touches the file again.
-        file.open(/*delayLoad=*/false);
-        auto readFloatGrid = [&](const std::string& name, const char* role) -> std::shared_ptr<const openvdb::GridBase> {
-            if (name.empty()) return nullptr;
-            reading = std::string(role) + " grid " + quote(name);
-            if (!file.hasGrid(name)) {
-                std::ostringstream msg;
-                msg << "VDB file " << quote(path) << " has no grid named " << quote(name) << " (" << role
-                    << "); grids in the file:";
-                bool any = false;
-                for (auto it = file.beginName(); it != file.endName(); ++it) {
-                    msg << (any ? ", " : " ") << quote(*it);
-                    try {
-                        msg << " (" << file.readGridMetadata(*it)->type() << ")";
-                    } catch (...) {
-                    }
-                    any = true;
-                }
-                if (!any) msg << " none";
-                throw GridLoadError(msg.str());
-            }
-            auto overCap = [&](std::uint64_t voxels, const char* how) {
-                return GridLoadError("grid " + quote(name) + " (" + role + ") in VDB file " + quote(path) + " has " +
-                                     std::to_string(voxels) + " active voxels (" + how + "), more than the grid-size cap of " +
-                                     std::to_string(desc.maxActiveVoxels) +
-                                     " (volphoton:maxGridVoxels on the RenderSettings prim, or --max-grid-voxels)");
-            };
-            if (desc.maxActiveVoxels > 0) {
-                openvdb::MetaMap::Ptr meta = file.readGridMetadata(name);
-                if (auto count = meta ? meta->getMetadata<openvdb::Int64Metadata>("file_voxel_count") : nullptr;
-                    count && count->value() > 0 && std::uint64_t(count->value()) > desc.maxActiveVoxels)
-                    throw overCap(std::uint64_t(count->value()), "recorded in the file");
-            }
-            openvdb::GridBase::Ptr g = file.readGrid(name);
-            if (!g) throw GridLoadError("VDB file " + quote(path) + ": could not read " + reading);
-            if (desc.maxActiveVoxels > 0 && g->activeVoxelCount() > desc.maxActiveVoxels)
-                throw overCap(g->activeVoxelCount(), "counted after reading");
-            if (!g->isType<FloatGrid>())
-                throw GridLoadError("grid " + quote(name) + " (" + role + ") in VDB file " + quote(path) +
-                                    " has value type " + g->valueType() + " (grid type " + g->type() +
-                                    "), but a float grid (FloatGrid) is required");
-            return g;
-        };
-        grids.density = readFloatGrid(desc.densityGrid, "density");
-        grids.temperature = readFloatGrid(desc.temperatureGrid, "temperature");
-        grids.emission = readFloatGrid(desc.emissionGrid, "emission");
-        grids.albedo = readFloatGrid(desc.albedoGrid, "albedo");
-        file.close();
-    } catch (const GridLoadError&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw std::runtime_error("cannot read VDB file " + quote(path) + " (" + reading +
-                                 "): the file is unreadable or corrupt: " + e.what());
-    } catch (...) {
-        throw std::runtime_error("cannot read VDB file " + quote(path) + " (" + reading +
-                                 "): the file is unreadable or corrupt");
-    }
+    auto read = readVdbFloatGrids(path,
+                                  {{desc.densityGrid, "density"},
+                                   {desc.temperatureGrid, "temperature"},
+                                   {desc.emissionGrid, "emission"},
+                                   {desc.albedoGrid, "albedo"}},
+                                  desc.maxActiveVoxels);
+    GridMediumGrids grids(read[0], read[1], read[2], read[3]);
     return std::shared_ptr<GridMedium>(new GridMedium(desc, grids, /*gridsOwned=*/true));
-}
-
-// ---- procedural cloud --------------------------------------------------------------------------
-
-namespace {
-
-/// Lattice value in [-1, 1] from one 64-bit mix of the seed and the integer coordinates.
-inline double latticeValue(uint64_t seed, int64_t i, int64_t j, int64_t k) {
-    uint64_t h = mix64(seed ^ (static_cast<uint64_t>(i) * 0x9E3779B97F4A7C15ULL) ^
-                       (static_cast<uint64_t>(j) * 0xC2B2AE3D27D4EB4FULL) ^ (static_cast<uint64_t>(k) * 0x165667B19E3779F9ULL));
-    return static_cast<double>(h >> 11) * (2.0 / 9007199254740992.0) - 1.0;
-}
-
-inline double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }  // quintic, C2
-
-/// Value noise with quintic interpolation (smooth, deterministic, only +, *, floor).
-double valueNoise(uint64_t seed, double x, double y, double z) {
-    double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-    int64_t i = static_cast<int64_t>(fx), j = static_cast<int64_t>(fy), k = static_cast<int64_t>(fz);
-    double u = fade(x - fx), v = fade(y - fy), w = fade(z - fz);
-    double c[8];
-    for (int n = 0; n < 8; ++n) c[n] = latticeValue(seed, i + (n >> 2), j + ((n >> 1) & 1), k + (n & 1));
-    double x00 = lerp(c[0], c[4], u), x01 = lerp(c[1], c[5], u), x10 = lerp(c[2], c[6], u), x11 = lerp(c[3], c[7], u);
-    return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w);
-}
-
-/// Five octaves of value noise, normalised to about [-1, 1].
-double fractalNoise(uint64_t seed, double x, double y, double z) {
-    double sum = 0, amp = 1, norm = 0, f = 1;
-    for (int o = 0; o < 5; ++o) {
-        sum += amp * valueNoise(mix64(seed + static_cast<uint64_t>(o)), x * f, y * f, z * f);
-        norm += amp;
-        amp *= 0.5;
-        f *= 2.03;
-    }
-    return sum / norm;
-}
-
-}  // namespace
-
-void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed) {
-    if (resolution < 1) throw std::invalid_argument("writeProceduralCloudVdb: resolution must be >= 1");
-    if (!(voxelSize > 0) || !std::isfinite(voxelSize))
-        throw std::invalid_argument("writeProceduralCloudVdb: voxelSize must be finite and > 0");
-    initOpenVdb();
-    const double centre = 0.5 * (resolution - 1);
-    const double radius = 0.45 * resolution;
-    const uint64_t noiseSeed = mix64(seed ^ 0x636c6f7564ULL);  // "cloud"
-    const int D = static_cast<int>(LeafT::DIM);
-    const int blocks = (resolution + D - 1) / D;
-
-    // Slabs of one leaf depth in z go to different trees (disjoint leaves), merged afterwards: the
-    // result does not depend on the thread schedule.
-    tbb::enumerable_thread_specific<FloatTree> trees(0.0f);
-    tbb::parallel_for(tbb::blocked_range<int>(0, blocks), [&](const tbb::blocked_range<int>& r) {
-        FloatTree& tree = trees.local();
-        openvdb::tree::ValueAccessor<FloatTree> acc(tree);
-        for (int b = r.begin(); b != r.end(); ++b)
-            for (int k = b * D; k < std::min(resolution, (b + 1) * D); ++k)
-                for (int j = 0; j < resolution; ++j)
-                    for (int i = 0; i < resolution; ++i) {
-                        double ux = (i - centre) / radius, uy = (j - centre) / radius, uz = (k - centre) / radius;
-                        double r2 = ux * ux + uy * uy + uz * uz;
-                        if (r2 >= 1) continue;
-                        double n = fractalNoise(noiseSeed, 2.5 * ux + 17.0, 2.5 * uy + 31.0, 2.5 * uz + 47.0);
-                        double d = (1.0 - r2) * (0.45 + 1.2 * n) * 1.4 - 0.08;
-                        if (d <= 0) continue;
-                        acc.setValue(Coord(i, j, k), static_cast<float>(std::min(d, 1.0)));
-                    }
-    });
-    FloatGrid::Ptr grid = FloatGrid::create(0.0f);
-    for (FloatTree& t : trees) grid->tree().merge(t, openvdb::MERGE_ACTIVE_STATES);
-    grid->setName("density");
-    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(voxelSize));
-    try {
-        openvdb::io::File file(path);
-        file.write({grid});
-        file.close();
-    } catch (const std::exception& e) {
-        throw std::runtime_error("cannot write VDB file " + quote(path) + ": " + e.what());
-    }
 }
 
 }  // namespace volphoton

@@ -26,11 +26,12 @@
 // Every coefficient, emission included, is 0 where the interpolated density is 0: the free-flight
 // sampler only visits points inside majorant segments, which cover exactly where density may be
 // non-zero, so emission elsewhere could never be gathered. The blackbody term follows Kirchhoff's
-// law (emission coefficient = absorption coefficient * blackbody radiance), as in pbrt-v4.
+// law (emission coefficient = absorption coefficient * blackbody radiance, blackbody.h), as in pbrt-v4.
 //
 // The medium's support is the density grid's active voxel bounding box dilated by one voxel (the
 // reach of trilinear interpolation); a non-zero background value applies inside it only.
 // NaN, infinite and negative values of every grid are clamped to 0 at load, with one warning per grid.
+// Files are read by vdbFile.h; the test scenes' cloud is written by proceduralCloud.h.
 #pragma once
 
 #include <cstdint>
@@ -38,16 +39,8 @@
 #include <string>
 #include <utility>
 
-#include <openvdb/version.h>  // light: only the version namespace macros
-
 #include "core/medium.h"
-
-namespace openvdb {
-OPENVDB_USE_VERSION_NAMESPACE
-namespace OPENVDB_VERSION_NAME {
-class GridBase;
-}
-}  // namespace openvdb
+#include "core/vdbFile.h"  // light: declares openvdb::GridBase only
 
 namespace volphoton {
 
@@ -89,26 +82,6 @@ struct GridMediumGrids {
     std::shared_ptr<const openvdb::GridBase> emission;
     std::shared_ptr<const openvdb::GridBase> albedo;
 };
-
-/// Chromaticity of a blackbody at `kelvin` as linear Rec.709/sRGB primaries, normalised to luminance
-/// 1: Planck's law integrated against the CIE 1931 2-degree colour matching functions in the
-/// multi-lobe Gaussian fit of Wyman, Sloan and Shirley 2013 ("Simple Analytic Approximations to the
-/// CIE XYZ Color Matching Functions", JCGT 2(2)), then XYZ -> linear sRGB, negative components
-/// clamped to 0. Tabulated at start-up; 0 for kelvin <= 0.
-Spectrum blackbodyColor(double kelvin);
-
-/// Blackbody radiance used for temperature emission (radiance units of the scene):
-///   blackbodyRadiance(T) = blackbodyColor(T) * (T / 1000 K)^4
-/// i.e. luminance follows the Stefan-Boltzmann T^4 law, normalised to 1 at 1000 K:
-/// | T (K)  | luminance |
-/// |--------|-----------|
-/// | 500    | 0.0625    |
-/// | 1000   | 1         |
-/// | 1500   | 5.06      |
-/// | 3000   | 81        |
-/// | 6500   | 1785      |
-/// Multiply by emissionScale (and, in the medium, by sigma_a) to tune brightness.
-Spectrum blackbodyRadiance(double kelvin);
 
 /// \class GridMedium
 /// Immutable after construction; properties() and majorants() are thread-safe.
@@ -158,19 +131,11 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// Opens desc.filePath, reads the named grids and builds the medium. Throws std::runtime_error naming
-/// the file and grid on a missing, unreadable or corrupt file, a grid name not in the file (the
-/// message lists the grids that are there), a grid that is not a FloatGrid (naming its type), a
-/// frustum (non-linear) grid transform, or a non-finite / non-invertible objectToWorld.
+/// Opens desc.filePath, reads the named grids (readVdbFloatGrids) and builds the medium. Throws
+/// std::runtime_error naming the file and grid on a missing, unreadable or corrupt file, a grid name
+/// not in the file (the message lists the grids that are there), a grid that is not a FloatGrid
+/// (naming its type), a frustum (non-linear) grid transform, or a non-finite / non-invertible
+/// objectToWorld.
 std::shared_ptr<GridMedium> loadGridMedium(const GridMediumDesc& desc);
-
-/// Writes a deterministic procedural cloud as a FloatGrid named "density" to `path`: a smooth
-/// fractal value-noise blob inside a sphere of radius 0.45 * resolution voxels centred in a
-/// resolution^3 box with its index-space origin at the corner, values in [0, 1], 0 (inactive) outside
-/// the blob, voxel size `voxelSize` scene units. The same (resolution, voxelSize, seed) gives the
-/// same voxels on every run, whatever the thread count (the file's bytes differ only in the UUID
-/// OpenVDB stamps into every file). Throws std::invalid_argument on resolution < 1 or voxelSize <= 0
-/// and std::runtime_error when the file cannot be written.
-void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed);
 
 }  // namespace volphoton

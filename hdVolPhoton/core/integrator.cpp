@@ -9,16 +9,6 @@
 
 namespace volphoton {
 
-double fresnelDielectric(double cosI, double eta) {
-    cosI = std::clamp(cosI, 0.0, 1.0);
-    double sin2T = (1 - cosI * cosI) / (eta * eta);
-    if (sin2T >= 1) return 1.0;  // total internal reflection
-    double cosT = std::sqrt(1 - sin2T);
-    double rs = (cosI - eta * cosT) / (cosI + eta * cosT);
-    double rp = (eta * cosI - cosT) / (eta * cosI + cosT);
-    return 0.5 * (rs * rs + rp * rp);
-}
-
 Integrator::Integrator(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
     transmittance_.cutoff = settings.transmittanceCutoff;
     std::vector<double> power;
@@ -95,71 +85,16 @@ double Integrator::leakDistance(const MediumStack& stack, const Ray& ray) const 
     return scene_.exitDistance(mesh, ray);
 }
 
-Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng,
-                                        bool mis) const {
-    const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
-    DirectSample ds = sampleDirect(hit.p, rng);
-    Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
-    double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
-    // The light must be on the viewer's side of the geometric surface too (no light leaks through).
-    if (!(cosL > 0) || !(ds.ls.pdf > 0) || ds.ls.Li.isBlack() || dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
-    Spectrum T = shadowTransmittance(hit.p, ds.ls.wi, ds.ls.dist, stack, rng, scene_.spawnTMin(hit, ds.ls.wi));
-    double lightDensity = ds.pickProb * ds.ls.pdf;
-    double w = mis && !ds.ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
-    return m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity);
-}
-
-SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng,
-                                          bool radianceMode) const {
-    SurfaceScatter s;
-    const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
-    Vec3 wo = -ray.d;
-    switch (m.kind) {
-        case SurfaceMaterial::Kind::Boundary:
-            stack.toggle(hit.mesh);
-            s.type = SurfaceScatter::Type::Pass;
-            s.next = {hit.p, ray.d};
-            s.tMin = scene_.spawnTMin(hit, ray.d);
-            s.crossed = true;
-            return s;
-        case SurfaceMaterial::Kind::Lambertian: {
-            if (m.albedo.isBlack()) return s;
-            Vec3 n = dot(wo, hit.ns) >= 0 ? hit.ns : -hit.ns;
-            auto [c1, c2] = rng.uniform2();
-            Vec3 w = Frame::fromZ(n).toWorld(cosineHemisphere(c1, c2));
-            if (dot(w, hit.ng) * dot(wo, hit.ng) <= 0) return s;  // shading normal sent it below the surface
-            s.type = SurfaceScatter::Type::Diffuse;
-            s.next = {hit.p, w};
-            s.tMin = scene_.spawnTMin(hit, w);
-            s.weight = m.albedo;  // f cos / pdf = (albedo/pi) cos / (cos/pi)
-            return s;
-        }
-        case SurfaceMaterial::Kind::Dielectric: {
-            bool inside = stack.contains(hit.mesh);
-            double eta = inside ? 1.0 / m.ior : m.ior;  // n_t / n_i along the path
-            Vec3 n = dot(wo, hit.ng) >= 0 ? hit.ng : -hit.ng;
-            double cosI = dot(wo, n);
-            double F = fresnelDielectric(cosI, eta);
-            if (rng.uniform() < F) {
-                Vec3 r = n * (2 * cosI) - wo;
-                s.type = SurfaceScatter::Type::Specular;
-                s.next = {hit.p, r};
-                s.tMin = scene_.spawnTMin(hit, r);
-                return s;
-            }
-            double sin2T = (1 - cosI * cosI) / (eta * eta);
-            double cosT = std::sqrt(std::max(0.0, 1 - sin2T));
-            Vec3 t = normalize(-wo / eta + n * (cosI / eta - cosT));
-            s.type = SurfaceScatter::Type::Specular;
-            s.next = {hit.p, t};
-            s.tMin = scene_.spawnTMin(hit, t);
-            s.crossed = true;
-            if (radianceMode) s.weight = Spectrum(1.0 / (eta * eta));
-            stack.toggle(hit.mesh);
-            return s;
-        }
-    }
-    return s;
+PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay) const {
+    PathSegment seg;
+    seg.hasHit = scene_.intersect(path.ray, path.tMin, path.tMax, &seg.hit);
+    seg.tEnd = seg.hasHit ? seg.hit.t : path.tMax;
+    seg.hasLight = hitLight(path.ray, seg.hasHit ? seg.tEnd : Infinity, &seg.tLight, &seg.lightLe, &seg.lightPdf, &seg.light,
+                            cameraRay);
+    if (seg.hasLight && !std::isinf(seg.tLight)) seg.tEnd = std::min(seg.tEnd, seg.tLight);
+    seg.leakExit = seg.hasHit ? Infinity : leakDistance(stack, path.ray);
+    if (seg.leakExit < seg.tEnd) seg.tEnd = seg.leakExit;
+    return seg;
 }
 
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings)

@@ -1,7 +1,9 @@
 // Pieces both integrators share: light selection by power, shadow transmittance through media and
-// index-matched boundaries, and surface scattering. Internal to the core.
+// index-matched boundaries, what a camera path meets next, and surfaces (surfaceInteraction.cpp:
+// scattering and the camera path's whole surface vertex). Internal to the core.
 #pragma once
 
+#include "core/functionRef.h"
 #include "core/integrator.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -23,6 +25,36 @@ struct SurfaceScatter {
     double tMin = 0;       ///< where the next surface intersection may start (self-hit avoidance)
     Spectrum weight{1.0};  ///< multiplies the path throughput
     bool crossed = false;  ///< the path went through the surface (refraction or boundary)
+};
+
+/// Boundary crossings a path may make before it is ended (a ray caught between coincident boundaries).
+constexpr int MaxBoundaryCrossings = 256;
+
+/// What a camera path meets next along its ray (Integrator::nextSegment): the nearest surface, the
+/// nearest light, and inside a broken mesh medium the way out through a hole; the medium segment
+/// ends at the nearest of them (or the ray's tMax).
+struct PathSegment {
+    SurfaceHit hit;
+    bool hasHit = false;
+    double tEnd = 0;  ///< end of the medium segment along the ray
+    bool hasLight = false;
+    double tLight = 0;  ///< the light's distance (infinity for distant and dome lights)
+    Spectrum lightLe;
+    double lightPdf = 0;  ///< the light's own solid-angle density of the direction (for MIS)
+    int light = -1;
+    double leakExit = Infinity;  ///< where the path leaves a broken mesh medium (Integrator::leakDistance)
+
+    /// The path reaches the light before any surface.
+    bool reachesLight() const { return hasLight && (!hasHit || tLight <= hit.t); }
+    /// The path leaves a broken mesh medium through a hole before meeting anything else.
+    bool leavesHole() const { return leakExit == tEnd && !std::isinf(leakExit); }
+};
+
+/// How a camera path goes on from a surface hit (Integrator::cameraSurfaceHit).
+enum class SurfaceStep {
+    Stop,     ///< absorbed, past settings.maxDepth or past MaxBoundaryCrossings: the path ends
+    Crossed,  ///< went straight through an index-matched boundary (no vertex; the medium changed)
+    Bounced,  ///< scattered by the surface (a vertex): the path goes on along the sampled direction
 };
 
 /// The ray a camera path follows: surfaces are searched in [tMin, tMax] (tMax is the camera's far
@@ -90,6 +122,20 @@ protected:
     Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
+    /// The surface, light and hole a camera path meets next along path.ray (surfaces in [tMin, tMax];
+    /// lights up to the surface, or to infinity without one). cameraRay as in hitLight().
+    PathSegment nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay) const;
+    /// A camera path at a surface hit, shared by both integrators' Li(). An index-matched boundary is
+    /// crossed (the stack toggled; Stop past MaxBoundaryCrossings). Any other surface is a vertex:
+    /// the front face of an emissive lambertian surface adds beta * emission; past settings.maxDepth
+    /// the path stops; else a lambertian surface adds its next-event estimate (directAtLambertian
+    /// with `mis`) and the surface is sampled (scatterSurface, radiance mode): Stop when absorbed,
+    /// else beta *= the sample's weight and the path bounces -> Bounced, the sample in *scatter.
+    /// `add` receives beta * emission and the direct estimate, in that order (the caller routes them
+    /// to its AOVs). Random numbers: directAtLambertian's, then scatterSurface's.
+    SurfaceStep cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, MediumStack& stack, Spectrum& beta, int& depth,
+                                 int& crossings, Rng& rng, bool mis, FunctionRef<void(const Spectrum&)> add,
+                                 SurfaceScatter* scatter) const;
     /// Distance at which a path inside a mesh medium with no surface ahead leaves the mesh's bounds
     /// (infinity when it is inside no mesh). Warns once per render: the mesh is not closed.
     double leakDistance(const MediumStack& stack, const Ray& ray) const;

@@ -45,6 +45,15 @@ inline Vec3 vmin(const Vec3& a, const Vec3& b) { return {std::min(a.x, b.x), std
 inline Vec3 vmax(const Vec3& a, const Vec3& b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
 inline bool isFinite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+inline double lerp(double a, double b, double t) { return a + (b - a) * t; }
+/// Trilinear blend of the eight corner values of a unit cell, c[(dx << 2) | (dy << 1) | dz] at corner
+/// (dx, dy, dz), at the fractions (u, v, w) across the cell.
+template <typename T>
+inline double trilinear(const T (&c)[8], double u, double v, double w) {
+    double x00 = lerp(c[0], c[4], u), x01 = lerp(c[1], c[5], u), x10 = lerp(c[2], c[6], u), x11 = lerp(c[3], c[7], u);
+    return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w);
+}
+
 /// RGB radiometric quantity (radiance, coefficients, throughput). Component-wise arithmetic.
 struct Spectrum {
     double c[3] = {0, 0, 0};

@@ -58,18 +58,9 @@ public:
         };
 
         while (true) {
-            SurfaceHit hit;
-            bool hasHit = scene_.intersect(ray, tMin, tMax, &hit);
-            double tEnd = hasHit ? hit.t : tMax;
-            double tLight;
-            Spectrum lightLe;
-            double lightPdf = 0;
-            int light = -1;
-            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light, firstSegment);
-            if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
-            if (firstSegment && hasHit) out.depth = hit.t;
-            double leakExit = hasHit ? Infinity : leakDistance(stack, ray);
-            if (leakExit < tEnd) tEnd = leakExit;
+            PathSegment ahead = nextSegment(path, stack, firstSegment);
+            const double tEnd = ahead.tEnd;
+            if (firstSegment && ahead.hasHit) out.depth = ahead.hit.t;
 
             // Medium interaction along [mediumFrom, tEnd].
             bool scattered = false, absorbed = false;
@@ -158,39 +149,31 @@ public:
                 if (!roulette(beta, depth, rng)) break;
                 continue;
             }
-            if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
-                path.leaveHole(stack, leakExit);
+            if (ahead.leavesHole()) {
+                path.leaveHole(stack, ahead.leakExit);
                 continue;
             }
             bool lightWasSingle = lightHitIsSingle;
             lightHitIsSingle = false;
             // Reached a light, a surface, or escaped.
-            if (hasLight && (!hasHit || tLight <= hit.t)) {
-                double w = specular ? 1.0 : powerHeuristic(prevPdf, lightPickProb(light) * lightPdf);
-                add(beta * lightLe * w, lightWasSingle);
-                if (firstSegment && !std::isinf(tLight)) out.alpha = 1;
+            if (ahead.reachesLight()) {
+                double w = specular ? 1.0 : powerHeuristic(prevPdf, lightPickProb(ahead.light) * ahead.lightPdf);
+                add(beta * ahead.lightLe * w, lightWasSingle);
+                if (firstSegment && !std::isinf(ahead.tLight)) out.alpha = 1;
                 break;
             }
-            if (!hasHit) break;
+            if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;
-            const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
-            if (m.kind == SurfaceMaterial::Kind::Boundary) {
-                if (++crossings > 256) break;
-                path.passBoundary(scatterSurface(ray, hit, stack, rng, true), hit.t);
-                continue;
-            }
+            // Surface light goes to `surface` when the surface is the first vertex (branch Undecided
+            // or Surface), else to `multiple`.
+            SurfaceScatter s;
+            SurfaceStep step = cameraSurfaceHit(path, ahead.hit, stack, beta, depth, crossings, rng, /*mis=*/true,
+                                                [&](const Spectrum& L) { add(L, false); }, &s);
+            if (step == SurfaceStep::Crossed) continue;
+            if (step == SurfaceStep::Stop) break;
             if (branch == Branch::Undecided) branch = Branch::Surface;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
-                add(beta * m.emission, false);  // emissive meshes are found by hits only (no light sampling)
-            if (++depth > settings_.maxDepth) break;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
-                add(beta * directAtLambertian(ray, hit, stack, rng, true), false);
-            SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
-            if (s.type == SurfaceScatter::Type::Absorbed) break;
-            beta *= s.weight;
             specular = s.type == SurfaceScatter::Type::Specular;
-            if (!specular) prevPdf = std::abs(dot(s.next.d, hit.ns)) * InvPi;
-            path.bounce(s.next, s.tMin);
+            if (!specular) prevPdf = std::abs(dot(s.next.d, ahead.hit.ns)) * InvPi;
             firstSegment = false;
             if (!roulette(beta, depth, rng)) break;
         }

@@ -93,18 +93,9 @@ public:
         auto route = [&](Spectrum& medium) -> Spectrum& { return firstSegment ? medium : out.surface; };
 
         while (true) {
-            SurfaceHit hit;
-            bool hasHit = scene_.intersect(ray, tMin, tMax, &hit);
-            double tEnd = hasHit ? hit.t : tMax;
-            double tLight;
-            Spectrum lightLe;
-            double lightPdf;
-            int light = -1;
-            bool hasLight = hitLight(ray, hasHit ? tEnd : Infinity, &tLight, &lightLe, &lightPdf, &light, firstSegment);
-            if (hasLight && !std::isinf(tLight)) tEnd = std::min(tEnd, tLight);
-            if (firstSegment && hasHit) out.depth = hit.t;
-            double leakExit = hasHit ? Infinity : leakDistance(stack, ray);
-            if (leakExit < tEnd) tEnd = leakExit;
+            PathSegment ahead = nextSegment(path, stack, firstSegment);
+            const double tEnd = ahead.tEnd;
+            if (firstSegment && ahead.hasHit) out.depth = ahead.hit.t;
 
             Spectrum Tseg(1.0);
             if (scene_.hasMedia()) {
@@ -122,36 +113,26 @@ public:
             }
             beta *= Tseg;
             if (beta.isBlack()) break;
-            if (leakExit == tEnd && !std::isinf(leakExit)) {  // left a broken mesh through a hole
-                path.leaveHole(stack, leakExit);
+            if (ahead.leavesHole()) {
+                path.leaveHole(stack, ahead.leakExit);
                 continue;
             }
-            if (hasLight && (!hasHit || tLight <= hit.t)) {
+            if (ahead.reachesLight()) {
                 // Lights are found by light sampling at diffuse vertices, so a hit counts only after
                 // the camera or specular bounces.
-                if (onlySpecular) out.surface += beta * lightLe;
-                if (firstSegment && !std::isinf(tLight)) out.alpha = 1;
+                if (onlySpecular) out.surface += beta * ahead.lightLe;
+                if (firstSegment && !std::isinf(ahead.tLight)) out.alpha = 1;
                 break;
             }
-            if (!hasHit) break;
+            if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;
-            const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
-            if (m.kind == SurfaceMaterial::Kind::Boundary) {
-                if (++crossings > 256) break;
-                path.passBoundary(scatterSurface(ray, hit, stack, rng, true), hit.t);
-                continue;
-            }
+            SurfaceScatter s;
+            SurfaceStep step = cameraSurfaceHit(path, ahead.hit, stack, beta, depth, crossings, rng, /*mis=*/false,
+                                                [&](const Spectrum& L) { out.surface += L; }, &s);
+            if (step == SurfaceStep::Crossed) continue;
+            if (step == SurfaceStep::Stop) break;
             firstSegment = false;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
-                out.surface += beta * m.emission;
-            if (++depth > settings_.maxDepth) break;
-            if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
-                out.surface += beta * directAtLambertian(ray, hit, stack, rng, false);
-            SurfaceScatter s = scatterSurface(ray, hit, stack, rng, true);
-            if (s.type == SurfaceScatter::Type::Absorbed) break;
-            beta *= s.weight;
             onlySpecular = onlySpecular && s.type == SurfaceScatter::Type::Specular;
-            path.bounce(s.next, s.tMin);
             if (depth >= settings_.rouletteDepth) {
                 double q = std::max(0.0, 1 - beta.maxValue());
                 if (rng.uniform() < q) break;
@@ -445,7 +426,9 @@ private:
         double pick;
         size_t source = sourceDist_.sampleDiscrete(rng.uniform(), &pick);
         double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
-        Ray ray;
+        // Surfaces are searched from path.tMin; media are tracked from the ray origin (mediumFrom 0).
+        PathRay path{Ray{}, 0.0, Infinity, 0.0};
+        Ray& ray = path.ray;
         Spectrum flux;
         int events = 0;  // scatterings, diffuse bounces and dielectric interactions so far
         if (source < scene_.lights().size()) {
@@ -462,10 +445,9 @@ private:
         }
         if (flux.isBlack() || !flux.isFinite()) return;
         MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
-        double tMin = 0;  // surfaces are searched from here; media from the ray origin
-        for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < 256;) {
+        for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < MaxBoundaryCrossings;) {
             SurfaceHit hit;
-            bool hasHit = scene_.intersect(ray, tMin, Infinity, &hit);
+            bool hasHit = scene_.intersect(ray, path.tMin, Infinity, &hit);
             double tEnd = hasHit ? hit.t : std::min(1e30, leakDistance(stack, ray));
             bool scattered = false, absorbed = false;
             MediumEvent ev{};
@@ -521,14 +503,11 @@ private:
                 // flux carries 1/(sigma_maj P_s) from spectral tracking; the kernel brings sigma_s.
                 flux *= mp.scatterKernel(cosTheta) / pdf;
                 for (int c = 0; c < 3; ++c) if (!std::isfinite(flux[c])) flux[c] = 0;
-                ray = {ev.p, w};
-                tMin = 0;
+                path.bounce({ev.p, w}, 0.0);
                 continue;
             }
-            if (!hasHit && tEnd < 1e30) {  // left a broken mesh through a hole (tEnd 0: see PathRay::leaveHole)
-                stack.toggle(stack.innermost());
-                ray = {ray.at(tEnd), ray.d};
-                if (tEnd > 0) tMin = 0;
+            if (!hasHit && tEnd < 1e30) {  // left a broken mesh through a hole
+                path.leaveHole(stack, tEnd);
                 ++crossings;
                 continue;
             }
@@ -538,8 +517,7 @@ private:
             if (s.type == SurfaceScatter::Type::Absorbed) return;
             if (s.type == SurfaceScatter::Type::Pass) {
                 ++crossings;
-                ray = s.next;
-                tMin = s.tMin;
+                path.passBoundary(s, hit.t);
                 continue;
             }
             ++depth;
@@ -555,8 +533,7 @@ private:
                 ++events;
                 flux *= s.weight;
             }
-            ray = s.next;
-            tMin = s.tMin;
+            path.bounce(s.next, s.tMin);
         }
     }
 

@@ -88,8 +88,8 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
         rec.mesh.material.albedo = HdVolPhoton_ToSpectrum(color.UncheckedGet<VtVec3fArray>()[0]);
     else if (color.IsHolding<GfVec3f>())
         rec.mesh.material.albedo = HdVolPhoton_ToSpectrum(color.UncheckedGet<GfVec3f>());
-    // XXX: UsdPreviewSurface networks (diffuseColor, emissiveColor) are read by the usd-core front
-    //      end only; the delegate uses displayColor.
+    // displayColor is the albedo of a mesh (or GeomSubset) without a material; a bound
+    // UsdPreviewSurface material (material.cpp) replaces it when the scene is built (sceneRegistry.cpp).
 
     rec.materialId = sceneDelegate->GetMaterialId(id);
     if (auto medium = HdVolPhoton_ReadMedium(sceneDelegate, id, /*isVolume=*/false, /*hasDensityField=*/false,

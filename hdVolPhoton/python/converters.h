@@ -103,13 +103,3 @@ struct type_caster<volphoton::Affine> {
 
 }  // namespace detail
 }  // namespace pybind11
-
-namespace volphoton::bindings {
-
-void registerImage(pybind11::module_& m);
-void registerVdbTestHelpers(pybind11::module_& m);
-void registerGltf(pybind11::module_& m);
-void registerTranslate(pybind11::module_& m);
-void bindVdbGuard(pybind11::module_& m);  // vdbGuardBindings.cpp
-
-}  // namespace volphoton::bindings

@@ -2,14 +2,14 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "converters.h"
+#include "bindings.h"
 #include "gltf/gltfToUsda.h"
 
 namespace py = pybind11;
 
 namespace volphoton::bindings {
 
-void registerGltf(py::module_& m) {
+void bindGltf(py::module_& m) {
     m.def("gltf_to_usda", [](const std::string& path, const std::string& rootName) {
         gltf::Translation t;
         {

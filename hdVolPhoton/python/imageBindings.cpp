@@ -22,7 +22,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "converters.h"
+#include "bindings.h"
 #include "core/imageIO.h"
 
 namespace py = pybind11;
@@ -197,7 +197,7 @@ std::vector<ExrChannel> channelsFromDict(const py::dict& planes, std::vector<py:
 
 }  // namespace
 
-void registerImage(py::module_& m) {
+void bindImage(py::module_& m) {
     m.def("write_exr", [](const std::string& path, const py::dict& planes, const std::map<std::string, std::string>& attrs,
                           const std::string& compression) {
         std::vector<py::array_t<float>> keep;

@@ -9,7 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include "converters.h"
+#include "bindings.h"
 #include "core/presets.h"
 #include "core/translate/light.h"
 #include "core/translate/medium.h"
@@ -72,16 +72,12 @@ py::object attrToPy(const AttrValue& v) {
     }, v);
 }
 
-template <class T>
-std::shared_ptr<T> mutableCopy(const std::shared_ptr<const T>& p) {
-    return std::const_pointer_cast<T>(p);
-}
 
 }  // namespace
 
 namespace volphoton::bindings {
 
-void registerTranslate(py::module_& m) {
+void bindTranslate(py::module_& m) {
     py::class_<PhaseParams>(m, "PhaseParams", "A validated phase function (core/translate/medium.h)")
         .def(py::init<>())
         .def_readwrite("kind", &PhaseParams::kind)

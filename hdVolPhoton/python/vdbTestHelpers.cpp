@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "bindings.h"
+
 namespace py = pybind11;
 
 namespace volphoton::bindings {
@@ -61,7 +63,7 @@ void writeTestVdb(const std::string& path, const std::map<std::string, std::stri
 
 }  // namespace
 
-void registerVdbTestHelpers(py::module_& m) {
+void bindVdbTestHelpers(py::module_& m) {
     m.def("write_test_vdb", [](const std::string& path, const std::map<std::string, std::string>& grids, int resolution,
                                double voxelSize, double value) {
         py::gil_scoped_release release;

@@ -14,10 +14,12 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include "core/blackbody.h"
 #include "core/diagnostics.h"
 #include "core/freeFlight.h"
 #include "core/gridMedium.h"
 #include "core/majorantGrid.h"
+#include "core/proceduralCloud.h"
 #include "core/rng.h"
 #include "core/sampling.h"
 

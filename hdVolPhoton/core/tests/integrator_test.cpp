@@ -8,6 +8,7 @@
 #include "core/homogeneousMedium.h"
 #include "core/integratorBase.h"
 #include "core/photonMap.h"
+#include "core/proceduralCloud.h"
 #include "tests/renderTestUtil.h"
 #include "tests/testUtil.h"
 

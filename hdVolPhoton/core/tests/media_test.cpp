@@ -302,6 +302,7 @@ TEST(MediaValidation, BadParametersThrow) {
 }
 
 #include "core/gridMedium.h"
+#include "core/proceduralCloud.h"
 
 TEST(MediaTransmittance, RatioTrackingIsUnbiasedOnVdb) {
     // A procedural cloud written and read back as a .vdb file, under a rotation + scale; the
