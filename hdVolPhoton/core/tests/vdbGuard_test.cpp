@@ -23,6 +23,7 @@
 
 #include "core/diagnostics.h"
 #include "core/gridMedium.h"
+#include "core/proceduralCloud.h"
 #include "core/vdbGuard.h"
 
 using namespace volphoton;
