@@ -69,7 +69,8 @@ void HdVolPhotonRenderDelegate::_Initialize() {
     auto add = [&](char const *name, TfToken const &key, VtValue const &value) {
         _settingDescriptors.push_back({name, key, value});
     };
-    add("Integrator (pathTracer, photonMap)", HdVolPhotonRenderSettingsTokens->integrator, VtValue(HdVolPhotonRenderSettingsTokens->pathTracer));
+    // A std::string, not a TfToken: usdview's settings dialog has no widget for a token.
+    add("Integrator (pathTracer, photonMap)", HdVolPhotonRenderSettingsTokens->integrator, VtValue(HdVolPhotonRenderSettingsTokens->pathTracer.GetString()));
     add("Samples per pixel", HdRenderSettingsTokens->convergedSamplesPerPixel, VtValue(d.samplesPerPixel));
     add("Thread limit (0: all cores)", HdRenderSettingsTokens->threadLimit, VtValue(d.threads));
     add("Max depth", HdVolPhotonRenderSettingsTokens->maxDepth, VtValue(d.maxDepth));
@@ -97,9 +98,22 @@ HdVolPhotonRenderDelegate::~HdVolPhotonRenderDelegate() {
 
 volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     volphoton::RenderSettings s;
-    TfToken integrator = GetRenderSetting<TfToken>(HdVolPhotonRenderSettingsTokens->integrator, HdVolPhotonRenderSettingsTokens->pathTracer);
-    s.integrator = integrator == HdVolPhotonRenderSettingsTokens->photonMap ? volphoton::RenderSettings::Integrator::PhotonMap
-                                                                            : volphoton::RenderSettings::Integrator::PathTracer;
+    // A string (the descriptor, usdview's dialog) or a token (a RenderSettings prim's attribute).
+    VtValue integratorValue = GetRenderSetting(HdVolPhotonRenderSettingsTokens->integrator);
+    std::string integrator = HdVolPhotonRenderSettingsTokens->pathTracer.GetString();
+    if (integratorValue.IsHolding<std::string>()) integrator = integratorValue.UncheckedGet<std::string>();
+    else if (integratorValue.IsHolding<TfToken>()) integrator = integratorValue.UncheckedGet<TfToken>().GetString();
+    else if (!integratorValue.IsEmpty())
+        TF_WARN("hdVolPhoton: render setting %s has type %s; using pathTracer", HdVolPhotonRenderSettingsTokens->integrator.GetText(),
+                integratorValue.GetTypeName().c_str());
+    if (integrator == HdVolPhotonRenderSettingsTokens->photonMap.GetString()) {
+        s.integrator = volphoton::RenderSettings::Integrator::PhotonMap;
+    } else {
+        if (integrator != HdVolPhotonRenderSettingsTokens->pathTracer.GetString())
+            TF_WARN("hdVolPhoton: render setting %s = \"%s\" is neither pathTracer nor photonMap; using pathTracer",
+                    HdVolPhotonRenderSettingsTokens->integrator.GetText(), integrator.c_str());
+        s.integrator = volphoton::RenderSettings::Integrator::PathTracer;
+    }
     s.samplesPerPixel = std::max(1, GetRenderSetting<int>(HdRenderSettingsTokens->convergedSamplesPerPixel, s.samplesPerPixel));
     s.threads = std::max(0, GetRenderSetting<int>(HdRenderSettingsTokens->threadLimit, s.threads));
     s.maxDepth = std::max(0, GetRenderSetting<int>(HdVolPhotonRenderSettingsTokens->maxDepth, s.maxDepth));
@@ -132,6 +146,10 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     s.multipleThreshold = number(HdVolPhotonRenderSettingsTokens->multipleThreshold, s.multipleThreshold, 0, Big);
     s.transmittanceCutoff = number(HdVolPhotonRenderSettingsTokens->transmittanceCutoff, s.transmittanceCutoff, 0, 1);
     return s;
+}
+
+bool HdVolPhotonRenderDelegate::IsInteractive() const {
+    return GetRenderSetting<bool>(HdRenderSettingsTokens->enableInteractive, true);
 }
 
 HdRenderParam *HdVolPhotonRenderDelegate::GetRenderParam() const { return _renderParam.get(); }
