@@ -51,6 +51,9 @@ openusd_complete() {
 }
 
 PXR_FOUND=$(openusd_with_imaging || true)
+if [ "$PXR_FOUND" = "$OPENUSD_PREFIX" ] && [ -f "$OPENUSD_TARBALL" ] && ! openusd_complete "$PXR_FOUND"; then
+  PXR_FOUND=""  # an interrupted unpack of the tarball: unpacked again below
+fi
 USE_TARBALL=""
 if [ -z "$PXR_FOUND" ] && [ -f "$OPENUSD_TARBALL" ]; then
   if [ "$(uname -m)" = x86_64 ] && grep -q '^VERSION_ID="12"' /etc/os-release 2>/dev/null; then
