@@ -23,11 +23,14 @@ APT_PACKAGES=(
   libopencolorio-dev libtinygltf-dev libgtest-dev
 )
 # The prebuilt OpenUSD's packages (../shared/openusd/README.md: runtime, then what building against
-# it needs), and what the usdview test needs: a virtual X server, Mesa's software GL, pip for
-# Debian's Python (it has none of its own) and the X libraries of PySide6's xcb platform plug-in.
+# it needs).
 OPENUSD_APT_PACKAGES=(
   libtbb12 libboost-python1.74.0 libosdcpu3.5.0 libosdgpu3.5.0 libgl1 libx11-6 libgomp1 libpython3.11 python3
   libtbb-dev libboost-python-dev libosd-dev libgl1-mesa-dev libx11-dev python3-dev
+)
+# What the usdview test needs with any OpenUSD that has usdview: a virtual X server, Mesa's software
+# GL, pip for Debian's Python (it has none of its own), the X libraries of PySide6's xcb plug-in.
+USDVIEW_TEST_APT_PACKAGES=(
   xvfb xauth libgl1-mesa-dri python3-pip
   libegl1 libfontconfig1 libdbus-1-3 libxkbcommon0 libxkbcommon-x11-0 libxcb-cursor0 libxcb-icccm4 libxcb-image0
   libxcb-keysyms1 libxcb-randr0 libxcb-render-util0 libxcb-shape0 libxcb-xkb1
@@ -58,10 +61,12 @@ USE_TARBALL=""
 if [ -z "$PXR_FOUND" ] && [ -f "$OPENUSD_TARBALL" ]; then
   if [ "$(uname -m)" = x86_64 ] && grep -q '^VERSION_ID="12"' /etc/os-release 2>/dev/null; then
     USE_TARBALL=1
-    APT_PACKAGES+=("${OPENUSD_APT_PACKAGES[@]}")
+    APT_PACKAGES+=("${OPENUSD_APT_PACKAGES[@]}" "${USDVIEW_TEST_APT_PACKAGES[@]}")
   else
     echo "setup: $OPENUSD_TARBALL is built for Debian 12 x86-64; not used here (Hydra delegate skipped)"
   fi
+elif [ -n "$PXR_FOUND" ] && [ -x "$PXR_FOUND/bin/usdview" ]; then
+  APT_PACKAGES+=("${USDVIEW_TEST_APT_PACKAGES[@]}")
 fi
 
 if [ -z "${VOLPHOTON_SKIP_APT:-}" ]; then
@@ -74,22 +79,19 @@ if [ -z "${VOLPHOTON_SKIP_APT:-}" ]; then
   fi
 fi
 
+# (A complete /opt/openusd was found above and is kept.)
 if [ -n "$USE_TARBALL" ]; then
-  if openusd_complete "$OPENUSD_PREFIX"; then
-    echo "setup: OpenUSD already unpacked in $OPENUSD_PREFIX"
-  else
-    echo "setup: unpacking $OPENUSD_TARBALL to $OPENUSD_PREFIX"
-    parent=$(dirname "$OPENUSD_PREFIX")
-    tmp=$($SUDO mktemp -d "$parent/.openusd-unpack.XXXXXX")
-    $SUDO tar -xJf "$OPENUSD_TARBALL" -C "$tmp"   # the tarball holds one folder, openusd/
-    openusd_complete "$tmp/openusd" || { echo "setup: the tarball did not unpack completely" >&2; exit 1; }
-    if [ -e "$OPENUSD_PREFIX" ]; then  # an earlier, interrupted unpack: kept aside, not deleted
-      echo "setup: $OPENUSD_PREFIX is incomplete; moved to $OPENUSD_PREFIX.incomplete.$$"
-      $SUDO mv "$OPENUSD_PREFIX" "$OPENUSD_PREFIX.incomplete.$$"
-    fi
-    $SUDO mv "$tmp/openusd" "$OPENUSD_PREFIX"
-    $SUDO rmdir "$tmp"
+  echo "setup: unpacking $OPENUSD_TARBALL to $OPENUSD_PREFIX"
+  parent=$(dirname "$OPENUSD_PREFIX")
+  tmp=$($SUDO mktemp -d "$parent/.openusd-unpack.XXXXXX")
+  $SUDO tar -xJf "$OPENUSD_TARBALL" -C "$tmp"   # the tarball holds one folder, openusd/
+  openusd_complete "$tmp/openusd" || { echo "setup: the tarball did not unpack completely" >&2; exit 1; }
+  if [ -e "$OPENUSD_PREFIX" ]; then  # an earlier, interrupted unpack: kept aside, not deleted
+    echo "setup: $OPENUSD_PREFIX is incomplete; moved to $OPENUSD_PREFIX.incomplete.$$"
+    $SUDO mv "$OPENUSD_PREFIX" "$OPENUSD_PREFIX.incomplete.$$"
   fi
+  $SUDO mv "$tmp/openusd" "$OPENUSD_PREFIX"
+  $SUDO rmdir "$tmp"
   PXR_FOUND=$OPENUSD_PREFIX
 fi
 
