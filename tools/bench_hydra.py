@@ -168,6 +168,7 @@ def first_frame_seconds(path: str, plugin: str):
     stage = Usd.Stage.Open(path)
     engine = make_engine(plugin)
     engine.SetRendererSetting("convergedSamplesPerPixel", 1)
+    engine.SetRendererSetting("enableInteractive", False)  # a batch render converges (see renderDelegate.h)
     f = frustum(camera_of(stage), 0.0)
     engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
     params = UsdImagingGL.RenderParams()

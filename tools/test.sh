@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of hdVolPhoton: the core's GoogleTest suite (Release), the same suite under
 # AddressSanitizer + UndefinedBehaviorSanitizer, the Python/USD tests (pytest), and the Hydra
-# delegate's tests where an OpenUSD build with imaging exists (else one SKIPPED line).
+# delegate's tests (usdrecord, usdview under Xvfb) with the OpenUSD the build found; one SKIPPED
+# line only where there is neither an OpenUSD with imaging nor the prebuilt tarball (../shared/openusd).
 # Expects tools/setup.sh to have run (it does not install anything itself).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,12 +28,22 @@ echo "== Python and USD tests"
 python -m pytest testenv -q --ignore=testenv/hydra || status=1
 
 echo "== Hydra delegate"
-if grep -q "^pxr_DIR:PATH=.*-NOTFOUND" build/CMakeCache.txt 2>/dev/null || ! grep -q "^pxr_DIR:PATH=" build/CMakeCache.txt 2>/dev/null; then
-  echo "SKIPPED hdVolPhoton Hydra tests: no OpenUSD >= 24.08 with imaging (find_package(pxr CONFIG) found none)"
-elif ! command -v usdrecord >/dev/null; then
-  echo "SKIPPED hdVolPhoton Hydra tests: OpenUSD found but usdrecord is not on PATH"
+# The OpenUSD the build found (its pxrConfig.cmake folder is the install root); its bin/ holds
+# usdrecord and usdview, put first on PATH for the Hydra tests.
+pxr_root=$(sed -n 's/^pxr_DIR:PATH=//p' build/CMakeCache.txt 2>/dev/null)
+openusd_tarball=$(cd .. && pwd)/shared/openusd/openusd-24.08-debian12-x86_64.tar.xz
+if [ -n "$pxr_root" ] && [[ "$pxr_root" != *-NOTFOUND ]] && [ -f build/hdVolPhoton/hd/hdVolPhoton.so ]; then
+  if [ -x "$pxr_root/bin/usdrecord" ]; then
+    PATH="$pxr_root/bin:$PATH" python -m pytest testenv/hydra -q || status=1
+  else
+    echo "FAILED hdVolPhoton Hydra tests: the build found OpenUSD at $pxr_root, which has no bin/usdrecord (build it with Python, imaging and usdImaging)"
+    status=1
+  fi
+elif [ -f "$openusd_tarball" ]; then
+  echo "FAILED hdVolPhoton Hydra tests: $openusd_tarball is there but the build has no Hydra delegate (run tools/setup.sh)"
+  status=1
 else
-  python -m pytest testenv/hydra -q || status=1
+  echo "SKIPPED hdVolPhoton Hydra tests: no OpenUSD >= 24.08 with imaging (find_package(pxr CONFIG) found none) and no $openusd_tarball"
 fi
 
 exit $status

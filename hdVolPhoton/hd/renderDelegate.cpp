@@ -110,6 +110,10 @@ volphoton::RenderSettings HdVolPhotonRenderDelegate::GetCoreSettings() const {
     return s;
 }
 
+bool HdVolPhotonRenderDelegate::IsInteractive() const {
+    return GetRenderSetting<bool>(HdRenderSettingsTokens->enableInteractive, true);
+}
+
 HdRenderParam *HdVolPhotonRenderDelegate::GetRenderParam() const { return _renderParam.get(); }
 TfTokenVector const &HdVolPhotonRenderDelegate::GetSupportedRprimTypes() const { return _Rprims(); }
 TfTokenVector const &HdVolPhotonRenderDelegate::GetSupportedSprimTypes() const { return _Sprims(); }

@@ -20,8 +20,9 @@ class HdVolPhotonRenderParam;
 /// Render settings (descriptors; the same meanings as hdVolPhoton/core/integrator.h):
 /// | key                          | type  | default    | meaning                                      |
 /// |------------------------------|-------|------------|----------------------------------------------|
-/// | volphoton:integrator         | token | pathTracer | pathTracer or photonMap                      |
-/// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes              |
+/// | volphoton:integrator         | string| pathTracer | pathTracer or photonMap (a token too)        |
+/// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes of a batch   |
+/// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
 /// | volphoton:maxDepth           | int   | 64         | scattering/bounce events per path            |
 /// | volphoton:photonsPerPass     | int   | 100000     | photonMap: photons per pass                  |
@@ -37,6 +38,16 @@ class HdVolPhotonRenderParam;
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
 /// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |
 /// Numbers may be authored as int, float or double; out-of-range values are clamped with a warning.
+/// The integrator's descriptor holds a std::string so usdview's settings dialog gives it a text
+/// field (UsdImagingGLEngine has widgets for bool, int, float and string only); a RenderSettings
+/// prim's `token volphoton:integrator` (or `string`) is accepted too.
+///
+/// Interactive or batch (enableInteractive, no descriptor, as hdPrman reads it): UsdAppUtils'
+/// frame recorder (usdrecord) sets it false; usdview and other viewers leave it unset (true). True:
+/// passes go on past convergedSamplesPerPixel until the render is stopped or restarted, and the
+/// render pass never reports converged (the viewer keeps refining, as Karma or Arnold do). False:
+/// exactly convergedSamplesPerPixel passes, then converged (usdrecord's loop on IsConverged ends).
+/// XXX: a noise target that ends an interactive render early is a later issue.
 #define HDVOLPHOTON_RENDER_SETTINGS_TOKENS \
     ((integrator, "volphoton:integrator"))  \
     ((maxDepth, "volphoton:maxDepth"))      \
@@ -102,6 +113,9 @@ public:
 
     /// The render settings as the core's struct (read when a render starts).
     volphoton::RenderSettings GetCoreSettings() const;
+    /// enableInteractive (default true): refine until stopped instead of converging at
+    /// convergedSamplesPerPixel (see the settings table above).
+    bool IsInteractive() const;
 
 private:
     void _Initialize();

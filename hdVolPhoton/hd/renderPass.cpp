@@ -97,7 +97,7 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
                 buffer->Allocate(GfVec3i(width, height, 1), buffer->GetFormat(), false);
             buffer->SetConverged(false);
         }
-    _renderer->SetScene(scene, settings, proj, aovs);
+    _renderer->SetScene(scene, settings, proj, aovs, _delegate->IsInteractive());
     _renderThread->StartRender();
     _started = true;
 }

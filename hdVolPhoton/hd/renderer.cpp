@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <thread>
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -18,11 +19,13 @@ PXR_NAMESPACE_OPEN_SCOPE
 using namespace volphoton;
 
 void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSettings const &settings,
-                                    GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings) {
+                                    GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings,
+                                    bool interactive) {
     _scene = std::move(scene);
     _settings = settings;
     _projection = projection;
     _aovBindings = aovBindings;
+    _interactive = interactive;
     std::lock_guard<std::mutex> lock(_statsMutex);
     _stats = RenderStats();
     _converged = false;
@@ -40,6 +43,7 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     VtDictionary d;
     d["passes"] = VtValue(_stats.passes);
     d["samplesPerPixel"] = VtValue(_stats.passes);
+    d["numCompletedSamples"] = VtValue(_stats.passes);  // shown by usdview's HUD (GPU stats)
     d["cameraSamples"] = VtValue(static_cast<uint64_t>(_stats.cameraSamples));
     d["photonsTraced"] = VtValue(static_cast<uint64_t>(_stats.photonsTraced));
     d["photonsStored"] = VtValue(static_cast<uint64_t>(_stats.photonsStored));
@@ -51,7 +55,8 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["passesSkipped"] = VtValue(VtStringArray(_stats.passesSkipped.begin(), _stats.passesSkipped.end()));
     d["framesWritten"] = VtValue(_framesWritten);
     d["previewBlock"] = VtValue(_previewBlock);
-    d["percentDone"] = VtValue(_settings.samplesPerPixel > 0 ? 100.0 * _stats.passes / _settings.samplesPerPixel : 100.0);
+    if (!_interactive)
+        d["percentDone"] = VtValue(_settings.samplesPerPixel > 0 ? 100.0 * _stats.passes / _settings.samplesPerPixel : 100.0);
     return d;
 }
 
@@ -81,7 +86,9 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
         auto fb = thread->LockFramebuffer();
         _WriteAovs(preview);
     }
-    for (int pass = 0; pass < _settings.samplesPerPixel; ++pass) {
+    // Interactive: "until stopped" (the core counts passes in an int; that many is out of reach).
+    int const passLimit = _interactive ? std::numeric_limits<int>::max() : _settings.samplesPerPixel;
+    for (int pass = 0; pass < passLimit; ++pass) {
         waitWhilePaused();
         double before = renderer->stats().seconds;
         if (!renderer->renderPass(cancel)) break;
@@ -89,7 +96,7 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
         {
             std::lock_guard<std::mutex> lock(_statsMutex);
             _stats = renderer->stats();
-            _converged = pass + 1 == _settings.samplesPerPixel;
+            _converged = !_interactive && pass + 1 == _settings.samplesPerPixel;
             ++_framesWritten;
         }
         auto fb = thread->LockFramebuffer();

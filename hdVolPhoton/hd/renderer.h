@@ -19,9 +19,15 @@ PXR_NAMESPACE_OPEN_SCOPE
 ///
 /// Not a Hydra prim: the render pass hands it a built core scene, settings, the camera's
 /// projection (for the depth AOV) and the AOV bindings while the render thread is stopped; the
-/// render thread then calls Render(), which runs core passes until samplesPerPixel is reached or a
-/// stop is requested, writing resolved AOVs into the bound render buffers after every pass under
-/// the framebuffer lock. Pausing is honoured between passes.
+/// render thread then calls Render(), which runs core passes until a stop is requested or, in a
+/// batch render, samplesPerPixel is reached, writing resolved AOVs into the bound render buffers
+/// after every pass under the framebuffer lock. Pausing is honoured between passes.
+///
+/// Batch or interactive (HdVolPhotonRenderDelegate::IsInteractive, enableInteractive): a batch
+/// render (usdrecord) stops after exactly samplesPerPixel passes and then reports converged; an
+/// interactive one (usdview) keeps adding passes until it is stopped or restarted and never reports
+/// converged, so the viewer keeps drawing. Stats: numCompletedSamples (usdview's HUD key) = passes;
+/// percentDone only in a batch render (an interactive one has no end).
 ///
 /// Interactive restarts: before the first pass, when the last full pass took longer than
 /// PreviewAfterSeconds (or no pass was timed yet), a coarse preview (volphoton::Renderer::renderPreview:
@@ -34,7 +40,7 @@ class HdVolPhoton_Renderer
 {
 public:
     void SetScene(std::shared_ptr<volphoton::Scene const> scene, volphoton::RenderSettings const &settings,
-                  GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings);
+                  GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings, bool interactive);
     void Render(HdRenderThread *renderThread);
     bool IsConverged() const;
     VtDictionary GetStats() const;
@@ -53,6 +59,7 @@ private:
     mutable std::mutex _statsMutex;
     volphoton::RenderStats _stats;
     bool _converged = false;
+    bool _interactive = false;  ///< passes go on past samplesPerPixel until stopped
     int _framesWritten = 0, _previewBlock = 0;
     bool _previewEnabled = true;
     double _lastPassSeconds = -1;  ///< render thread only; kept across restarts (-1: none timed yet)

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): pause, resume,
-stop, convergence, restart on a camera change, and when the coarse preview is shown. Run by
+"""Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): interactive
+refinement past samplesPerPixel, batch convergence, pause, resume, stop, restart on a camera change,
+when the coarse preview is shown, and the integrator setting as usdview's dialog sets it. Run by
 test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
 PXR_PLUGINPATH_NAME:
 
@@ -62,12 +63,22 @@ def main(scene, camera_path):
             time.sleep(0.01)
         return first, passes()
 
-    # Converges at convergedSamplesPerPixel and stays there. (Set after the first Render(): the
-    # scene's RenderSettings prim, synced then, sets it too.)
+    # The engine leaves enableInteractive unset, as usdview does: an interactive render.
     # The first render has no pass time to go by: a 4x4-block preview comes before the first pass.
     render_until(lambda: stats()["framesWritten"] >= 2)
     check(stats()["previewBlock"] == 4, "the first render starts with a 4x4 preview: %s" % stats()["previewBlock"])
+    # Interactive: refines past convergedSamplesPerPixel until stopped and never reports converged,
+    # so a viewer keeps drawing. (Set after the first Render(): the scene's RenderSettings prim,
+    # synced then, sets it too.)
     engine.SetRendererSetting("convergedSamplesPerPixel", 4)
+    render_until(lambda: passes() >= 3 * 4)
+    s = stats()
+    check(not engine.IsConverged(), "an interactive render is not converged after 3x its samplesPerPixel")
+    check("percentDone" not in s and s["numCompletedSamples"] == s["passes"], "interactive stats: %s" % s)
+
+    # Batch, as usdrecord (UsdAppUtilsFrameRecorder sets enableInteractive false): converges at
+    # convergedSamplesPerPixel and stays there.
+    engine.SetRendererSetting("enableInteractive", False)
     render_until(lambda: passes() > 0 and engine.IsConverged())
     s = stats()
     check(s["passes"] == 4 and s["percentDone"] == 100.0, "converged after exactly 4 passes: %s" % s["passes"])
@@ -103,6 +114,18 @@ def main(scene, camera_path):
     render_until(lambda: restarted.append(passes()) or restarted[-1] < before)
     render_until(lambda: passes() >= 2)
     check(stats()["sceneVersion"] == version, "a camera change does not rebuild the scene version")
+
+    # The integrator as usdview's settings dialog shows and sets it: a string setting (a text field;
+    # UsdImagingGL has no widget for a token and warns "doesn't have a UI"). photonsTraced tells
+    # which integrator runs: the path tracer traces none.
+    listed = {str(x.key): x for x in engine.GetRendererSettingsList()}
+    check("volphoton:integrator" in listed and listed["volphoton:integrator"].type == UsdImagingGL.RendererSettingType.STRING,
+          "the integrator is listed as a string setting: %s" % sorted(listed))
+    check(engine.GetRendererSetting("volphoton:integrator") == "pathTracer", "the integrator's default is pathTracer")
+    for value, photons in (("photonMap", True), ("pathTracer", False)):
+        engine.SetRendererSetting("volphoton:integrator", value)  # a Python str: a std::string, as the dialog sets it
+        render_until(lambda: passes() >= 1)
+        check((stats()["photonsTraced"] > 0) == photons, "%s: photonsTraced %s" % (value, stats()["photonsTraced"]))
     engine.StopRenderer()
     print("OK")
     return 0

@@ -187,3 +187,37 @@ def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
     assert not np.array_equal(images["default"], images["independent"])
     assert "volphoton:radiusAlpha: radiusAlpha = 7 is outside [1e-06, 1]; clamped to 1" in logs["badalpha"], logs["badalpha"]
     assert np.isfinite(images["badalpha"]).all() and abs(images["badalpha"].mean() - 1) < 0.1
+
+
+def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
+    """volphoton:integrator on a RenderSettings prim selects the integrator whether authored as a
+    token or as a string (the delegate's descriptor is a string so usdview's dialog can edit it):
+    the two spellings render bit-identically, "pathTracer" as the default does, and "photonMap"
+    differently (the photon map's passes draw other random numbers)."""
+    base = open(os.path.join(TESTENV, "furnace.usda")).read()
+    base = base.replace("int2 resolution = (32, 32)", "int2 resolution = (16, 16)")
+    base = base.replace("int volphoton:samplesPerPixel = 16", "int volphoton:samplesPerPixel = 4")
+    anchor = "int volphoton:maxDepth = 1000"
+    assert anchor in base and "volphoton:integrator" not in base
+    variants = {"default": "", "pathTracerToken": 'token volphoton:integrator = "pathTracer"',
+                "pathTracerString": 'string volphoton:integrator = "pathTracer"',
+                "photonMapToken": 'token volphoton:integrator = "photonMap"',
+                "photonMapString": 'string volphoton:integrator = "photonMap"',
+                "misspelt": 'token volphoton:integrator = "photonmapper"'}
+    images, logs = {}, {}
+    for name, extra in variants.items():
+        path = tmp_path / (name + ".usda")
+        path.write_text(base.replace(anchor, anchor + "\n        " + extra))
+        out = str(tmp_path / (name + ".exr"))
+        r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility",
+                                      "--camera", "/World/camera", "--imageWidth", "16", str(path), out])
+        assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
+        images[name], logs[name] = rgb(out), r.stdout + r.stderr
+    assert np.array_equal(images["default"], images["pathTracerToken"])
+    assert np.array_equal(images["default"], images["pathTracerString"])
+    assert np.array_equal(images["photonMapToken"], images["photonMapString"])
+    assert not np.array_equal(images["default"], images["photonMapToken"])
+    # Both integrators see the same white furnace (radiance 1), so the photon map is no broken image.
+    assert abs(images["photonMapString"].mean() - 1) < 0.1, images["photonMapString"].mean()
+    assert np.array_equal(images["default"], images["misspelt"])
+    assert 'volphoton:integrator = "photonmapper" is neither' in logs["misspelt"], logs["misspelt"]

@@ -83,6 +83,8 @@ int main(int argc, char **argv) {
         return 1;
     }
     engine.SetRendererSetting(TfToken("convergedSamplesPerPixel"), VtValue(1));
+    // A batch render, as usdrecord's: converged after that one pass (interactive ones refine on).
+    engine.SetRendererSetting(TfToken("enableInteractive"), VtValue(false));
     engine.SetCameraPath(SdfPath(argv[2]));
     engine.SetRenderBufferSize(GfVec2i(width, height));
     engine.SetFraming(CameraUtilFraming(GfRect2i(GfVec2i(0, 0), width, height)));
