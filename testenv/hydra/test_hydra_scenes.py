@@ -220,4 +220,5 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     # Both integrators see the same white furnace (radiance 1), so the photon map is no broken image.
     assert abs(images["photonMapString"].mean() - 1) < 0.1, images["photonMapString"].mean()
     assert np.array_equal(images["default"], images["misspelt"])
-    assert 'volphoton:integrator = "photonmapper" is neither' in logs["misspelt"], logs["misspelt"]
+    assert "volphoton:integrator: unusable value 'photonmapper' (one of pathTracer, photonMap)" in logs["misspelt"], \
+        logs["misspelt"]
