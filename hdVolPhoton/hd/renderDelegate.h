@@ -23,7 +23,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:integrator         | token | pathTracer | pathTracer or photonMap                      |
 /// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes              |
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
-/// | volphoton:maxDepth           | int   | 64         | scattering/bounce events per path            |
+/// | volphoton:maxDepth           | int   | 100000     | events per path (safety cap; lower: biased)  |
 /// | volphoton:photonsPerPass     | int   | 100000     | photonMap: photons per pass                  |
 /// | volphoton:initialRadius      | float | 0 (auto)   | photonMap: beam radius of pass 0             |
 /// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |
