@@ -55,7 +55,10 @@ Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double di
     for (int crossings = 0; crossings < 64; ++crossings) {
         SurfaceHit hit;
         double remaining = dist - travelled;
-        bool blocked = scene_.intersect(ray, tMin, remaining * (1 - 1e-7) - scene_.epsilon(), &hit);
+        // Short of the far end by its float precision (a light sample on a surface is not occluded
+        // by that surface).
+        double tMax = remaining * (1 - 1e-7) - (std::isinf(remaining) ? 0.0 : Scene::floatError(ray.at(remaining)));
+        bool blocked = scene_.intersect(ray, tMin, tMax, &hit);
         double segment = blocked ? hit.t : remaining;
         if (scene_.hasMedia()) {
             MediumAggregate media = scene_.mediaFor(stack);

@@ -6,7 +6,12 @@
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased) or photonMap                |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass      |
-// | maxDepth            | int    | 64         |              | scattering/bounce events per path                 |
+// | maxDepth            | int    | 100000     |              | scattering/bounce events per path. The default is |
+// |                     |        |            |              | a safety cap only (Russian roulette ends paths,   |
+// |                     |        |            |              | deep ones too: integratorBase.h): unbiased. A     |
+// |                     |        |            |              | lower value is an artistic control and BIASED     |
+// |                     |        |            |              | (dense bright media, e.g. clouds, milk, marble,   |
+// |                     |        |            |              | render too dark)                                  |
 // | rouletteDepth       | int    | 3          |              | events before Russian roulette may end a path     |
 // | seed                | uint64 | 0          |              | every random stream hashes (pixel, pass, seed)    |
 // | stratifiedDims      | int    | 32         |              | draws per camera sample taken from scrambled      |
@@ -66,7 +71,10 @@ struct RenderSettings {
     Integrator integrator = Integrator::PathTracer;
     int width = 640, height = 360;
     int samplesPerPixel = 16;
-    int maxDepth = 64;
+    /// A safety cap, not a truncation: no furnace or slab test sees it (Russian roulette ends paths
+    /// long before; DeepRouletteDepth in integratorBase.h ends even lossless ones).
+    static constexpr int DefaultMaxDepth = 100000;
+    int maxDepth = DefaultMaxDepth;
     int rouletteDepth = 3;
     uint64_t seed = 0;
     int threads = 0;

@@ -17,6 +17,22 @@ struct DirectSample {
     int light = -1;
 };
 
+/// Russian roulette past DeepRouletteDepth events: a path survives each further event with
+/// probability at most DeepRouletteSurvival (its weight divided by it: unbiased). Ordinary roulette
+/// on the throughput ends paths in absorbing media long before; this ends the paths that lose no
+/// energy (an albedo-1 enclosure), on average 1000 events later, so the default maxDepth
+/// (RenderSettings::DefaultMaxDepth) stays a safety cap that no furnace or slab test can detect.
+constexpr int DeepRouletteDepth = 1024;
+constexpr double DeepRouletteSurvival = 0.999;
+
+/// Probability that a path at `depth` events with throughput maximum `betaMax` goes on (depth at
+/// least RenderSettings::rouletteDepth): the throughput itself, at most DeepRouletteSurvival once
+/// the path is deep.
+inline double rouletteSurvival(double betaMax, int depth) {
+    double p = std::min(1.0, betaMax);
+    return depth >= DeepRouletteDepth ? std::min(p, DeepRouletteSurvival) : p;
+}
+
 /// Outcome of scattering at a surface for a path arriving along direction d.
 struct SurfaceScatter {
     enum class Type { Absorbed, Diffuse, Specular, Pass };

@@ -270,10 +270,10 @@ private:
 
     bool roulette(Spectrum& beta, int depth, Rng& rng) const {
         if (depth < settings_.rouletteDepth) return true;
-        double q = std::max(0.0, 1 - beta.maxValue());
-        if (q <= 0) return true;
-        if (rng.uniform() < q) return false;
-        beta /= 1 - q;
+        double p = rouletteSurvival(beta.maxValue(), depth);
+        if (p >= 1) return true;
+        if (!(rng.uniform() < p)) return false;
+        beta /= p;
         return true;
     }
 };

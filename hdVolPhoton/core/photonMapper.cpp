@@ -134,9 +134,11 @@ public:
             firstSegment = false;
             onlySpecular = onlySpecular && s.type == SurfaceScatter::Type::Specular;
             if (depth >= settings_.rouletteDepth) {
-                double q = std::max(0.0, 1 - beta.maxValue());
-                if (rng.uniform() < q) break;
-                beta /= 1 - q;
+                double p = rouletteSurvival(beta.maxValue(), depth);
+                if (p < 1) {
+                    if (!(rng.uniform() < p)) break;
+                    beta /= p;
+                }
             }
         }
         return out;
@@ -496,7 +498,10 @@ private:
                     out->push_back(ph);
                 }
                 ++events;
-                ++depth;
+                if (++depth >= DeepRouletteDepth) {  // albedo 1 loses nothing: end deep photons too
+                    if (!(rng.uniform() < DeepRouletteSurvival)) return;
+                    flux /= DeepRouletteSurvival;
+                }
                 Vec3 w = mp.sampleScatter(ray.d, rng.uniform(), rng.uniform(), rng.uniform());
                 double cosTheta = dot(ray.d, w), pdf = mp.scatterPdf(cosTheta);
                 if (!(pdf > 0)) return;
@@ -524,13 +529,17 @@ private:
             if (m.kind == SurfaceMaterial::Kind::Lambertian) {
                 ++events;
                 // Russian roulette on the reflectance keeps photon power roughly constant.
-                double q = std::clamp(s.weight.average(), 0.0, 1.0);
+                double q = std::clamp(s.weight.average(), 0.0, depth >= DeepRouletteDepth ? DeepRouletteSurvival : 1.0);
                 if (rng.uniform() >= q) return;
                 flux *= s.weight / q;
             } else {
                 // The single-scattering pass cannot see through or via a dielectric (its shadow rays
                 // stop there), so events after a specular interaction belong to the photon map.
                 ++events;
+                if (depth >= DeepRouletteDepth) {
+                    if (!(rng.uniform() < DeepRouletteSurvival)) return;
+                    flux /= DeepRouletteSurvival;
+                }
                 flux *= s.weight;
             }
             path.bounce(s.next, s.tMin);

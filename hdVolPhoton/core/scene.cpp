@@ -145,9 +145,6 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     }
     center_ = (bounds.lo + bounds.hi) * 0.5;
     radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
-    double extent = std::max({std::abs(bounds.lo.x), std::abs(bounds.lo.y), std::abs(bounds.lo.z), std::abs(bounds.hi.x),
-                              std::abs(bounds.hi.y), std::abs(bounds.hi.z), radius_});
-    epsilon_ = 1e-5 * extent;  // Embree works in single precision: offsets relative to the scene's extent
 }
 
 Scene::~Scene() {
@@ -186,15 +183,38 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
     const InstanceDesc& id = desc_.instances[inst];
     const MeshDesc& m = desc_.meshes[id.mesh];
     hit->t = rh.ray.tfar;
-    hit->p = ray.at(hit->t);
     hit->mesh = id.mesh;
     hit->instance = inst;
     hit->triangle = static_cast<int>(rh.hit.primID);
     uint32_t i0 = m.indices[3 * rh.hit.primID], i1 = m.indices[3 * rh.hit.primID + 1], i2 = m.indices[3 * rh.hit.primID + 2];
-    Vec3 nObj = cross(m.points[i1] - m.points[i0], m.points[i2] - m.points[i0]);
+    const Vec3 &a = m.points[i0], &b = m.points[i1], &c = m.points[i2];
+    Vec3 nObj = cross(b - a, c - a);
     Vec3 ng = Affine::normal(instanceInverse_[inst], nObj);
     double len = length(ng);
     hit->ng = len > 0 ? ng / len : Vec3(0, 0, 1);
+    // The point from the barycentrics, in double: on the triangle's plane whatever the error of the
+    // float t (which grows with the distance travelled), so a ray spawned from it needs an offset
+    // for the triangle's own precision only. Its bound (pbrt-v4's idea): the rounding of each
+    // coordinate scales with sum_i b_i |v_i| in object space, carried to world space by |M|, plus
+    // the rounding of the translation; projected on |ng|.
+    double bu = std::clamp<double>(rh.hit.u, 0.0, 1.0), bv = std::clamp<double>(rh.hit.v, 0.0, 1.0 - bu), bw = 1 - bu - bv;
+    Vec3 pObj = a * bw + b * bu + c * bv;
+    Vec3 aObj(std::abs(a.x) * bw + std::abs(b.x) * bu + std::abs(c.x) * bv, std::abs(a.y) * bw + std::abs(b.y) * bu + std::abs(c.y) * bv,
+              std::abs(a.z) * bw + std::abs(b.z) * bu + std::abs(c.z) * bv);
+    const Affine& M = id.transform;
+    hit->p = M.point(pObj);
+    double err[3];
+    for (int r = 0; r < 3; ++r)
+        err[r] = FloatError * (std::abs(M.m[r][0]) * aObj.x + std::abs(M.m[r][1]) * aObj.y + std::abs(M.m[r][2]) * aObj.z +
+                               std::abs(M.m[r][3]));
+    hit->pError = std::abs(hit->ng.x) * err[0] + std::abs(hit->ng.y) * err[1] + std::abs(hit->ng.z) * err[2];
+    // Exactly representable planes (z = 0 with identity transforms) have no error at all, and Embree
+    // accepts t = tnear: a floor far below any other offset keeps spawned rays strictly off them.
+    hit->pError = std::max(hit->pError, 1e-3 * floatError(hit->p)) + std::numeric_limits<float>::min();
+    if (!isFinite(hit->p) || !std::isfinite(hit->pError)) {  // degenerate instance: fall back on the ray
+        hit->p = ray.at(hit->t);
+        hit->pError = floatError(hit->p);
+    }
     hit->ns = hit->ng;
     if (!m.normals.empty()) {
         double u = rh.hit.u, v = rh.hit.v;
@@ -224,7 +244,8 @@ MediumAggregate Scene::mediaFor(const MediumStack& stack) const {
 double Scene::exitDistance(int mesh, const Ray& ray) const {
     double t0, t1;
     const Bounds3& b = meshBounds_[mesh];
-    Bounds3 padded{b.lo - Vec3(1, 1, 1) * epsilon_, b.hi + Vec3(1, 1, 1) * epsilon_};
+    double pad = std::max(floatError(b.lo), floatError(b.hi));  // the float precision of the bounds
+    Bounds3 padded{b.lo - Vec3(1, 1, 1) * pad, b.hi + Vec3(1, 1, 1) * pad};
     if (b.empty() || !padded.intersect(ray, 0.0, Infinity, &t0, &t1)) return Infinity;
     return t1;
 }
@@ -233,16 +254,19 @@ MediumStack Scene::stackAt(const Vec3& p) const {
     MediumStack stack;
     // Parity along a fixed, non-axis-aligned probe direction; the nearest first crossing of a
     // containing mesh belongs to the innermost one, so containing meshes are pushed far to near.
+    // The probe restarts at each crossing with that crossing's own offset (spawnTMin).
     Ray probe{p, normalize(Vec3(0.5773, 0.5774, 0.5775))};
-    std::vector<std::pair<int, double>> crossings;  // mesh, first t
+    std::vector<std::pair<int, double>> crossings;  // mesh, first distance along the probe
     std::vector<int> parity(desc_.meshes.size(), 0);
-    double t = 0;
+    double tMin = 0, travelled = 0;
     SurfaceHit hit;
-    for (int n = 0; n < 1024 && intersect(probe, t, Infinity, &hit); ++n) {
+    for (int n = 0; n < 1024 && intersect(probe, tMin, Infinity, &hit); ++n) {
+        travelled += hit.t;
         if (desc_.meshes[hit.mesh].material.kind != SurfaceMaterial::Kind::Lambertian) {
-            if (parity[hit.mesh]++ == 0) crossings.push_back({hit.mesh, hit.t});
+            if (parity[hit.mesh]++ == 0) crossings.push_back({hit.mesh, travelled});
         }
-        t = hit.t + epsilon_;
+        probe.o = hit.p;
+        tMin = spawnTMin(hit, probe.d);
     }
     std::sort(crossings.begin(), crossings.end(), [](auto& a, auto& b) { return a.second > b.second; });
     for (auto& [mesh, first] : crossings)

@@ -14,6 +14,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -71,6 +73,10 @@ struct SurfaceHit {
     int mesh = -1;
     int instance = -1;
     int triangle = -1;  ///< index of the triangle within the mesh
+    /// Bound on how far, along ng, the surface Embree intersects (single precision: rounded
+    /// vertices, transform and ray origin) may lie from p. It follows the magnitude of the
+    /// triangle's own coordinates, never the scene's size (Scene::spawnTMin).
+    double pError = 0;
 };
 
 /// The closed dielectric and boundary meshes the path is inside, innermost last. Crossing one toggles
@@ -134,16 +140,26 @@ public:
     /// Bounding sphere of geometry and bounded media (for distant and dome light photons).
     Vec3 center() const { return center_; }
     double radius() const { return radius_; }
-    /// Scale of the scene for ray offsets.
-    double epsilon() const { return epsilon_; }
-    /// Ray parameter from which a ray leaving `hit` along w may meet surfaces again: clear of the
-    /// surface by the scene epsilon (Embree intersects in single precision). Rays start exactly at
-    /// the hit point, so the medium behind a surface is tracked from the surface itself; offsetting
-    /// the origin instead skipped a layer of medium, which matters when the mean free path is
-    /// below the epsilon.
-    double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
-        return epsilon_ / std::max(std::abs(dot(w, hit.ng)), 0.1);
+    /// Bound on the single-precision rounding error of a point p: FloatError x max_i |p_i|.
+    /// Offsets that have no surface to go by (shadow-ray ends, mesh bounds) use it.
+    static double floatError(const Vec3& p) {
+        return FloatError * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
     }
+    /// Ray parameter from which a ray leaving `hit` along w may meet surfaces again: past the slab of
+    /// half-width hit.pError around the surface, measured along w (a grazing direction is taken at
+    /// no less than MinSpawnCos). The offset follows the local float precision of the hit (pbrt-v4's
+    /// error bounds), not the scene's extent: a thin layer or a close surface far from any large
+    /// object keeps its own scale. Rays start exactly at the hit point, so the medium behind a
+    /// surface is tracked from the surface itself; offsetting the origin instead skipped a layer
+    /// of medium, which matters when the mean free path is below the offset.
+    double spawnTMin(const SurfaceHit& hit, const Vec3& w) const {
+        return hit.pError / std::max(std::abs(dot(w, hit.ng)), MinSpawnCos);
+    }
+    /// Relative error bound for single-precision intersection (vertices, instance transform and
+    /// ray origin rounded to float, then Embree's watertight test): 16 float epsilons, about four
+    /// times pbrt-v4's gamma(7) + gamma(3) for the same steps.
+    static constexpr double FloatError = 16 * 1.1920928955078125e-07;
+    static constexpr double MinSpawnCos = 0.02;
 
 private:
     SceneDesc desc_;
@@ -154,7 +170,7 @@ private:
     std::vector<Bounds3> meshBounds_;  ///< world bounds of each mesh over its instances
     bool hasMedia_ = false, emissiveMedia_ = false;
     Vec3 center_;
-    double radius_ = 1, epsilon_ = 1e-6;
+    double radius_ = 1;
     std::vector<char> meshClosed_;
 };
 

@@ -24,7 +24,7 @@ class HdVolPhotonRenderParam;
 /// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes of a batch   |
 /// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
-/// | volphoton:maxDepth           | int   | 64         | scattering/bounce events per path            |
+/// | volphoton:maxDepth           | int   | 100000     | events per path (safety cap; lower: biased)  |
 /// | volphoton:photonsPerPass     | int   | 100000     | photonMap: photons per pass                  |
 /// | volphoton:initialRadius      | float | 0 (auto)   | photonMap: beam radius of pass 0             |
 /// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |

@@ -53,7 +53,8 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
                            "passes; one camera sample per pixel per pass", &RS::samplesPerPixel));
     t.push_back(intSetting("maxDepth", 0, Big, "--max-depth", "volphoton:maxDepth", "Max depth", "events",
-                           "scattering/bounce events per path", &RS::maxDepth));
+                           "scattering/bounce events per path; the default is a safety cap (unbiased), lower values are "
+                           "an artistic control and BIASED (dense bright media darken)", &RS::maxDepth));
     t.push_back(intSetting("rouletteDepth", 0, Big, "", "volphoton:rouletteDepth", "Russian roulette depth", "events",
                            "events before Russian roulette may end a path", &RS::rouletteDepth));
     t.push_back({"seed", SettingType::Int, 0, 9.2e18, {}, "--seed", "volphoton:seed", "Seed", "",

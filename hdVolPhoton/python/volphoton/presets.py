@@ -60,8 +60,9 @@ How translucent objects are rendered (single scattering included)
         only the photon map renders that -- and small bright lights are noisy.  Light translucent
         objects with area or dome lights when the two integrators must agree.
     Dense presets at real scale take hundreds to thousands of scattering events per path (a 2 cm
-    marble object has an optical size of about 50): raise ``maxDepth`` (the default 64 truncates,
-    darkening the object) and lower ``photonsPerPass`` (each photon is stored at every event).
+    marble object has an optical size of about 50): the default ``maxDepth`` (a safety cap) does not
+    truncate them (a lower one does, darkening the object); lower ``photonsPerPass`` (each photon is
+    stored at every event).
 """
 
 from __future__ import annotations
