@@ -23,7 +23,10 @@ from hydra_util import TESTENV, run_usdrecord, volphoton_exe
 from pxr import Sdf, Usd, UsdGeom  # noqa: E402
 from volphoton import output  # noqa: E402
 
-SEEDS = [1, 2, 3, 4]
+# Eight seeds: with four, the per-block z of the speckled fog scenes at 4 spp follows a t-distribution
+# with few degrees of freedom (fog_spotlight: mean z^2 3.02 at seeds 1-4 although the image means
+# agree within 0.5 sigma over 12 seeds: CLI 0.0915 +- 0.0040, usdrecord 0.0892 +- 0.0021).
+SEEDS = [1, 2, 3, 4, 5, 6, 7, 8]
 SIZE = (64, 36)
 SPP = 4
 SCENES = sorted(f for f in os.listdir(TESTENV) if f.endswith(".usda"))
