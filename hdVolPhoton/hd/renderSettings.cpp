@@ -21,7 +21,7 @@ void HdVolPhotonRenderSettings::_Sync(HdSceneDelegate *, HdRenderParam *, HdDirt
     if (IsActive()) *_sawActive = true;
     if ((!IsActive() && *_sawActive) || !(*dirtyBits & (DirtyActive | DirtyNamespacedSettings))) return;
     // volphoton:<name> -> the table entry's Hydra key (convergedSamplesPerPixel, threadLimit, or
-    // volphoton:<name> itself); names not in the table are passed on and warned about by the core.
+    // volphoton:<name> itself); names not in the table are warned about and dropped.
     for (auto const &[name, value] : GetNamespacedSettings()) {
         std::string const &n = name;
         volphoton::translate::SettingInfo const *info =

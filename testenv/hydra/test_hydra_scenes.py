@@ -160,19 +160,14 @@ def test_dome_hidden_from_the_camera_unless_asked(tmp_path, hydra_env):
     assert 0 < means[False][1] < means[True][1], means               # the lit medium remains
 
 
-def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
-    """volphoton:* settings beyond the basic ones (here stratifiedDims, authored as int and as double,
-    and an out-of-range radiusAlpha) reach the core through the render-settings Bprim: the same
-    seed renders bit-identically with the default value spelled out, differently with another value,
-    and an out-of-range value is clamped with a warning naming the setting."""
+def _render_furnace_variants(tmp_path, hydra_env, variants, check_base=None):
+    """usdrecord renders of furnace.usda at 16x16 and 4 spp, each with one variant's extra lines on its
+    RenderSettings prim: ({name: image}, {name: log})."""
     base = open(os.path.join(TESTENV, "furnace.usda")).read()
     base = base.replace("int2 resolution = (32, 32)", "int2 resolution = (16, 16)")
     base = base.replace("int volphoton:samplesPerPixel = 16", "int volphoton:samplesPerPixel = 4")
     anchor = "int volphoton:samplesPerPixel = 4"  # furnace.usda no longer sets maxDepth (issue 14)
-    assert anchor in base
-    variants = {"default": "", "same": "int volphoton:stratifiedDims = 32", "asdouble": "double volphoton:stratifiedDims = 32",
-                "independent": "int volphoton:stratifiedDims = 0",
-                "badalpha": 'float volphoton:radiusAlpha = 7\n        token volphoton:integrator = "photonMap"'}
+    assert anchor in base and (check_base is None or check_base(base))
     images, logs = {}, {}
     for name, extra in variants.items():
         path = tmp_path / (name + ".usda")
@@ -182,6 +177,18 @@ def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
                                       "--camera", "/World/camera", "--imageWidth", "16", str(path), out])
         assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
         images[name], logs[name] = rgb(out), r.stdout + r.stderr
+    return images, logs
+
+
+def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
+    """volphoton:* settings beyond the basic ones (here stratifiedDims, authored as int and as double,
+    and an out-of-range radiusAlpha) reach the core through the render-settings Bprim: the same
+    seed renders bit-identically with the default value spelled out, differently with another value,
+    and an out-of-range value is clamped with a warning naming the setting."""
+    variants = {"default": "", "same": "int volphoton:stratifiedDims = 32", "asdouble": "double volphoton:stratifiedDims = 32",
+                "independent": "int volphoton:stratifiedDims = 0",
+                "badalpha": 'float volphoton:radiusAlpha = 7\n        token volphoton:integrator = "photonMap"'}
+    images, logs = _render_furnace_variants(tmp_path, hydra_env, variants)
     assert np.array_equal(images["default"], images["same"])
     assert np.array_equal(images["default"], images["asdouble"])
     assert not np.array_equal(images["default"], images["independent"])
@@ -194,25 +201,13 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     token or as a string (the delegate's descriptor is a string so usdview's dialog can edit it):
     the two spellings render bit-identically, "pathTracer" as the default does, and "photonMap"
     differently (the photon map's passes draw other random numbers)."""
-    base = open(os.path.join(TESTENV, "furnace.usda")).read()
-    base = base.replace("int2 resolution = (32, 32)", "int2 resolution = (16, 16)")
-    base = base.replace("int volphoton:samplesPerPixel = 16", "int volphoton:samplesPerPixel = 4")
-    anchor = "int volphoton:samplesPerPixel = 4"  # furnace.usda no longer sets maxDepth (issue 14)
-    assert anchor in base and "volphoton:integrator" not in base
     variants = {"default": "", "pathTracerToken": 'token volphoton:integrator = "pathTracer"',
                 "pathTracerString": 'string volphoton:integrator = "pathTracer"',
                 "photonMapToken": 'token volphoton:integrator = "photonMap"',
                 "photonMapString": 'string volphoton:integrator = "photonMap"',
                 "misspelt": 'token volphoton:integrator = "photonmapper"'}
-    images, logs = {}, {}
-    for name, extra in variants.items():
-        path = tmp_path / (name + ".usda")
-        path.write_text(base.replace(anchor, anchor + "\n        " + extra))
-        out = str(tmp_path / (name + ".exr"))
-        r = run_usdrecord(hydra_env, ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility",
-                                      "--camera", "/World/camera", "--imageWidth", "16", str(path), out])
-        assert r.returncode == 0 and os.path.exists(out), r.stdout + r.stderr
-        images[name], logs[name] = rgb(out), r.stdout + r.stderr
+    images, logs = _render_furnace_variants(tmp_path, hydra_env, variants,
+                                            check_base=lambda base: "volphoton:integrator" not in base)
     assert np.array_equal(images["default"], images["pathTracerToken"])
     assert np.array_equal(images["default"], images["pathTracerString"])
     assert np.array_equal(images["photonMapToken"], images["photonMapString"])
