@@ -233,11 +233,15 @@ def stage_up(stage: Usd.Stage) -> Vec3:
     return (0.0, 0.0, 1.0) if UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z else (0.0, 1.0, 0.0)
 
 
-def read_attributes(prim: Usd.Prim, time, prefix: str = "volphoton:"):
-    """({name: plain value}, [authored names]) of the prim's attributes under ``prefix`` that have a
-    value at ``time`` (authored or a registered fallback)."""
+def read_attributes(prim: Usd.Prim, time, prefix: str = "volphoton:", names=None):
+    """({name: plain value}, [authored names]) of the prim's attributes under ``prefix`` (or, with
+    ``names``, of those attributes only) that have a value at ``time`` (authored or a registered
+    fallback)."""
     values, authored = {}, []
-    for attr in prim.GetAttributes():
+    attrs = prim.GetAttributes() if names is None else (prim.GetAttribute(n) for n in names)
+    for attr in attrs:
+        if not attr:
+            continue
         name = attr.GetName()
         if not name.startswith(prefix):
             continue

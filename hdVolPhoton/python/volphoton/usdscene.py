@@ -129,10 +129,11 @@ PRESETS = vpresets.PRESETS
 
 # Renderer settings read from a UsdRender Settings prim as ``volphoton:<name>`` attributes: the C++
 # table (core/translate/settings.h) the CLI flags and the Hydra delegate share.
-SETTINGS_TABLE = {e["name"]: e for e in _core.render_settings_table()}
-SETTINGS_ATTRIBUTES = tuple(SETTINGS_TABLE)
+SETTINGS_ATTRIBUTES = tuple(e["name"] for e in _core.render_settings_table())
 
-# UsdLux schema -> the translation layer's light kinds (anything else: "not supported").
+# The UsdLux attributes the translation layer reads, and the UsdLux schemas -> its light kinds
+# (anything else: "not supported").
+_LIGHT_ATTRIBUTES = tuple(_core.light_attribute_names())
 _LIGHT_KINDS = (("distant", UsdLux.DistantLight), ("sphere", UsdLux.SphereLight), ("rect", UsdLux.RectLight),
                 ("disk", UsdLux.DiskLight), ("dome", UsdLux.DomeLight))
 SPHERE_SEGMENTS, SPHERE_RINGS = 48, 24
@@ -947,9 +948,7 @@ class _Translator:
         if world is None:
             return
         kind = next((k for k, t in _LIGHT_KINDS if prim.IsA(t)), "")
-        values, _ = vschema.read_attributes(prim, self.time, prefix="")
-        wanted = set(_core.light_attribute_names())
-        values = {k: v for k, v in values.items() if k in wanted}
+        values, _ = vschema.read_attributes(prim, self.time, prefix="", names=_LIGHT_ATTRIBUTES)
         tex = prim.GetAttribute("inputs:texture:file").Get(self.time) if kind == "dome" else None
         asset = tex.path if tex is not None else ""
         if kind == "dome":
