@@ -124,7 +124,7 @@ echo "setup: building and installing the volphoton Python package (C++ core + bi
 CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)} pip install -q --no-build-isolation .
 
 echo "setup: building the C++ core, its tests and tools in build/"
-pxr_flag=(); [ -n "$PXR_FOUND" ] && pxr_flag=(-Dpxr_DIR="$PXR_FOUND")
+pxr_flag=(); [ -n "$PXR_FOUND" ] && pxr_flag=(-Dpxr_DIR:PATH="$PXR_FOUND")
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "${pxr_flag[@]}" >/dev/null
 cmake --build build
 [ -f testenv/cloud.vdb ] || python tools/make_cloud_vdb.py testenv/cloud.vdb

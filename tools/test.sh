@@ -30,7 +30,7 @@ python -m pytest testenv -q --ignore=testenv/hydra || status=1
 echo "== Hydra delegate"
 # The OpenUSD the build found (its pxrConfig.cmake folder is the install root); its bin/ holds
 # usdrecord and usdview, put first on PATH for the Hydra tests.
-pxr_root=$(sed -n 's/^pxr_DIR:PATH=//p' build/CMakeCache.txt 2>/dev/null)
+pxr_root=$(sed -n 's/^pxr_DIR:[A-Z]*=//p' build/CMakeCache.txt 2>/dev/null)  # PATH, or UNINITIALIZED when given by -D without a type
 openusd_tarball=$(cd .. && pwd)/shared/openusd/openusd-24.08-debian12-x86_64.tar.xz
 if [ -n "$pxr_root" ] && [[ "$pxr_root" != *-NOTFOUND ]] && [ -f build/hdVolPhoton/hd/hdVolPhoton.so ]; then
   if [ -x "$pxr_root/bin/usdrecord" ]; then
