@@ -5,7 +5,7 @@
 #include "core/exponentialMedium.h"
 #include "core/translate/medium.h"
 #include "core/gridMedium.h"
-#include "core/vdbGuard.h"
+#include "core/translate/volume.h"
 
 #include <sstream>
 
@@ -79,59 +79,32 @@ size_t HdVolPhoton_SceneRegistry::GetLightCount() const {
 
 MediumPtr HdVolPhoton_SceneRegistry::_GridMedium(SdfPath const &id, HdVolPhoton_VolumeRecord const &rec,
                                                 std::uint64_t maxGridVoxels, translate::Diagnostics &diagnostics) const {
-    auto fieldRecord = [&](char const *name) -> HdVolPhoton_FieldRecord const * {
-        auto it = rec.fields.find(name);
-        if (it == rec.fields.end()) return nullptr;
-        auto f = _fields.find(it->second);
-        return f == _fields.end() ? nullptr : &f->second;
-    };
-    HdVolPhoton_FieldRecord const *density = fieldRecord("density");
-    if (!density) {
-        diagnostics.error(id.GetString(), "field:density", "the density field prim was not synced; volume skipped");
-        return nullptr;
+    // The synced field Bprims as the translation layer reads them (core/translate/volume.h has the rules).
+    std::vector<translate::GridFieldInput> fields;
+    for (auto const &[slot, fieldId] : rec.fields) {
+        auto f = _fields.find(fieldId);
+        if (f != _fields.end())
+            fields.push_back({slot, f->second.primPath, f->second.filePath, f->second.fieldName, f->second.fieldIndex});
+        else if (slot == "density")
+            diagnostics.error(id.GetString(), "field:density", "the density field prim was not synced; volume skipped");
     }
-    GridMediumDesc g = translate::gridMediumDesc(rec.medium, rec.objectToWorld, diagnostics);
-    g.filePath = density->filePath;
-    g.densityGrid = density->fieldName.empty() ? "density" : density->fieldName;
-    g.maxActiveVoxels = maxGridVoxels;
-    for (auto [slot, target] : {std::pair<char const *, std::string *>{"temperature", &g.temperatureGrid},
-                                {"emission", &g.emissionGrid}, {"albedo", &g.albedoGrid}}) {
-        if (HdVolPhoton_FieldRecord const *f = fieldRecord(slot)) {
-            if (f->filePath != density->filePath)
-                diagnostics.error(id.GetString(), std::string("field:") + slot,
-                                  "the field is in " + f->filePath + " but the density field is in " + density->filePath +
-                                      "; every field must come from the density's file; field ignored");
-            else *target = f->fieldName.empty() ? slot : f->fieldName;
-        }
-    }
+    std::optional<GridMediumDesc> g =
+        translate::gridMediumFromFields(id.GetString(), rec.medium, rec.objectToWorld, fields, maxGridVoxels, diagnostics);
+    if (!g) return nullptr;
     // Grids are cached across rebuilds by everything that shapes them: every medium parameter
     // (translate::mediumKey), the file, the grids, the cap and the transform.
     std::ostringstream key;
     key.precision(17);
-    key << translate::mediumKey(rec.medium) << '|' << g.filePath << '|' << g.densityGrid << '|' << g.temperatureGrid << '|'
-        << g.emissionGrid << '|' << g.albedoGrid << '|' << g.maxActiveVoxels << '|';
+    key << translate::mediumKey(rec.medium) << '|' << g->filePath << '|' << g->densityGrid << '|' << g->temperatureGrid
+        << '|' << g->emissionGrid << '|' << g->albedoGrid << '|' << g->maxActiveVoxels << '|';
     for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) key << g.objectToWorld.m[r][c] << ',';
+        for (int c = 0; c < 4; ++c) key << g->objectToWorld.m[r][c] << ',';
     auto cached = _gridCache.find(key.str());
     if (cached != _gridCache.end()) return cached->second;
-    // The reader guard (core/vdbGuard.h): a file that would crash or hang the reader is probed in a
-    // separate process and skipped here, not loaded into the host (as the usd-core front end does).
-    if (std::optional<std::string> problem = vdbCrashCheck(g)) {
-        diagnostics.error(density->primPath.empty() ? id.GetString() : density->primPath, "filePath",
-                          "field:density of " + id.GetString() + " (file " + g.filePath + "): " + *problem +
-                              "; volume skipped");
-        return nullptr;
-    }
-    try {
-        MediumPtr medium = loadGridMedium(g);
-        _gridCache[key.str()] = medium;
-        return medium;
-    } catch (std::exception const &e) {
-        diagnostics.error(density->primPath.empty() ? id.GetString() : density->primPath, "filePath",
-                          "field:density of " + id.GetString() + " (file " + g.filePath + ", grid '" + g.densityGrid +
-                              "'): " + e.what() + "; volume skipped");
-        return nullptr;
-    }
+    std::string const densityPrim = _fields.at(rec.fields.at("density")).primPath;
+    MediumPtr medium = translate::loadGridMediumReported(id.GetString(), densityPrim, *g, diagnostics);
+    if (medium) _gridCache[key.str()] = medium;
+    return medium;
 }
 
 SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera, std::uint64_t maxGridVoxels) const {

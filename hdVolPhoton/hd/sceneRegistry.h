@@ -46,7 +46,7 @@ struct HdVolPhoton_FieldRecord {
     std::string primPath;  ///< the OpenVDBAsset prim, for messages
     std::string filePath;
     std::string fieldName;
-    int fieldIndex = 0;
+    int fieldIndex = -1;  ///< -1 when not authored
 };
 
 /// A volume as synced: its medium parameters, transform and the field prims it binds by name

@@ -14,6 +14,7 @@
 #include "core/translate/light.h"
 #include "core/translate/medium.h"
 #include "core/translate/settings.h"
+#include "core/translate/volume.h"
 
 namespace py = pybind11;
 using namespace volphoton;
@@ -148,11 +149,33 @@ void bindTranslate(py::module_& m) {
         return py::make_tuple(medium ? py::cast(mutableCopy(medium)) : py::none(), kind, toPy(d));
     }, py::arg("params"), py::arg("object_to_world"), py::arg("use_bounds"),
        "(Medium or None, 'homogeneous'|'exponential', diagnostics)");
-    m.def("grid_medium_desc", [](const MediumParams& p, const Affine& world) {
+    py::class_<GridFieldInput>(m, "GridFieldInput",
+                               "An OpenVDBAsset bound to a volume's field:<slot> (core/translate/volume.h)")
+        .def(py::init([](std::string slot, std::string primPath, std::string filePath, std::string fieldName,
+                         int fieldIndex) {
+                 return GridFieldInput{std::move(slot), std::move(primPath), std::move(filePath), std::move(fieldName),
+                                       fieldIndex};
+             }),
+             py::arg("slot"), py::arg("prim_path"), py::arg("file_path"), py::arg("field_name") = "",
+             py::arg("field_index") = -1);
+    m.def("grid_medium_from_fields", [](const std::string& volumePath, const MediumParams& p, const Affine& world,
+                                        const std::vector<GridFieldInput>& fields, std::uint64_t maxActiveVoxels) {
         Diagnostics d;
-        GridMediumDesc g = gridMediumDesc(p, world, d);
-        return py::make_tuple(g, toPy(d));
-    }, py::arg("params"), py::arg("object_to_world"), "(GridMediumDesc without file and grids, diagnostics)");
+        std::optional<GridMediumDesc> g = gridMediumFromFields(volumePath, p, world, fields, maxActiveVoxels, d);
+        return py::make_tuple(g ? py::cast(*g) : py::none(), toPy(d));
+    }, py::arg("volume_path"), py::arg("params"), py::arg("object_to_world"), py::arg("fields"),
+       py::arg("max_active_voxels"), "(GridMediumDesc or None when there is no density file, diagnostics)");
+    m.def("load_grid_medium_reported", [](const std::string& volumePath, const std::string& densityPrim,
+                                          const GridMediumDesc& desc) {
+        Diagnostics d;
+        MediumPtr medium;
+        {
+            py::gil_scoped_release release;
+            medium = loadGridMediumReported(volumePath, densityPrim, desc, d);
+        }
+        return py::make_tuple(medium ? py::cast(mutableCopy(medium)) : py::none(), toPy(d));
+    }, py::arg("volume_path"), py::arg("density_prim"), py::arg("desc"),
+       "(Medium or None, diagnostics): loadGridMedium behind the reader guard, errors as diagnostics");
     m.def("effective_coefficients", [](const MediumParams& p) {
         Diagnostics d;
         EffectiveCoefficients c = effectiveCoefficients(p, d);

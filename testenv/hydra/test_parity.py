@@ -350,6 +350,61 @@ def test_preset_on_a_vdb_volume_reaches_both_doors(tmp_path, hydra_env):
     assert_doors_agree(hydra, cli, "ketchup preset on a VDB volume")
 
 
+SPLIT_FIELDS = '''    def Volume "smoke" (
+        prepend apiSchemas = ["VolPhotonMediumAPI"]
+    )
+    {
+        float volphoton:density = 4
+        color3f volphoton:albedo = (0.7, 0.7, 0.7)
+        float volphoton:emissionScale = 5
+        rel field:density = </World/smoke/density>
+        rel field:emission = </World/smoke/glow>
+        double3 xformOp:translate = (-1, -1, -1)
+        float3 xformOp:scale = (2, 2, 2)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+
+        def OpenVDBAsset "density"
+        {
+            asset filePath = @%(vdb)s@
+            int fieldIndex = 0
+        }
+
+        def OpenVDBAsset "glow"
+        {
+            asset filePath = @%(other)s@
+            token fieldName = "density"
+        }
+    }
+
+    def DomeLight "sky"
+    {
+        float inputs:intensity = 1
+    }
+'''
+
+
+def test_grid_fields_follow_one_set_of_rules_in_both_doors(tmp_path, hydra_env):
+    """A Volume whose density asset has no fieldName (the grid is the slot's name, "density") and an
+    authored fieldIndex, and whose emission field is in another file: both doors select the grid by
+    name with a warning naming the asset and fieldIndex, ignore the emission field with an error
+    naming the glow asset and filePath, and render the same non-emissive smoke
+    (core/translate/volume.h).  Without the shared rules the delegate compared paths as strings and
+    never warned about fieldIndex."""
+    other = str(tmp_path / "other.vdb")
+    _core.write_procedural_cloud_vdb(other, 16, 1.0 / 16, 2)
+    body = SPLIT_FIELDS % {"vdb": cloud_vdb(tmp_path), "other": other}
+    hydra, cli, hlog, clog = render_both(hydra_env, tmp_path, "split", lambda s: stage_text(body, s))
+    for door, log in (("CLI", clog), ("delegate (usdrecord)", hlog)):
+        check(warning_lines(log, "/World/smoke/density", "fieldIndex", "ignored"),
+              "%s: no warning naming /World/smoke/density and fieldIndex:\n%s" % (door, log[-3000:]))
+        check(warning_lines(log, "/World/smoke/glow", "filePath", "density's file"),
+              "%s: no error naming /World/smoke/glow, filePath and the one-file rule:\n%s" % (door, log[-3000:]))
+    # The smoke is there (it blocks part of the unit dome) and emits nothing (the emission field is
+    # ignored, and emissionScale alone does not make a grid volume glow).
+    check(0.05 < cli.mean() < 0.95, "the CLI's smoke is missing or glows: mean %.3f" % cli.mean())
+    assert_doors_agree(hydra, cli, "grid fields from two files")
+
+
 # --------------------------------------------------------------------------------------------------
 # 4. Exponential haze on a Z-up stage
 # --------------------------------------------------------------------------------------------------

@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "core/translate/light.h"
 #include "core/translate/medium.h"
 #include "core/translate/settings.h"
+#include "core/translate/volume.h"
+#include "core/proceduralCloud.h"
 
 using namespace volphoton;
 using namespace volphoton::translate;
@@ -114,6 +118,58 @@ TEST(TranslateMedium, PresetReplacesTheCoefficients) {
     m.preset = "tomato";
     effectiveCoefficients(m, d);
     EXPECT_TRUE(hasDiagnostic(d, Severity::Error, "volphoton:preset"));
+}
+
+TEST(TranslateVolume, GridFieldsSelectGridsByNameFromTheDensityFile) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(::testing::TempDir()) / "translate_volume";
+    fs::create_directories(dir);
+    const std::string file = (dir / "cloud.vdb").string(), other = (dir / "other.vdb").string();
+    writeProceduralCloudVdb(file, 8, 1.0 / 8, 1);
+    writeProceduralCloudVdb(other, 8, 1.0 / 8, 2);
+    const fs::path alias = dir / "alias.vdb";  // another spelling of the same file
+    fs::remove(alias);
+    fs::create_symlink(file, alias);
+
+    MediumParams params;
+    std::vector<GridFieldInput> fields = {
+        {"density", "/V/density", file, "", 0},           // no fieldName: the slot's name; fieldIndex warned
+        {"temperature", "/V/temp", alias.string(), "heat", -1},  // same file through a link: kept
+        {"emission", "/V/glow", other, "density", -1},     // another file: error, ignored
+    };
+    Diagnostics d;
+    std::optional<GridMediumDesc> g = gridMediumFromFields("/V", params, Affine{}, fields, 1234, d);
+    ASSERT_TRUE(g);
+    EXPECT_EQ(g->filePath, file);
+    EXPECT_EQ(g->densityGrid, "density");
+    EXPECT_EQ(g->temperatureGrid, "heat");
+    EXPECT_EQ(g->emissionGrid, "");
+    EXPECT_EQ(g->maxActiveVoxels, 1234u);
+    EXPECT_TRUE(hasDiagnostic(d, Severity::Warning, "fieldIndex"));
+    EXPECT_TRUE(hasDiagnostic(d, Severity::Error, "filePath"));
+    ASSERT_EQ(d.list().size(), 2u);
+
+    // No density file: nothing to build, and nothing to say (the field's reader reported it).
+    Diagnostics none;
+    EXPECT_FALSE(gridMediumFromFields("/V", params, Affine{}, {{"density", "/V/density", "", "", -1}}, 0, none));
+    EXPECT_FALSE(gridMediumFromFields("/V", params, Affine{}, {{"emission", "/V/glow", file, "", -1}}, 0, none));
+    EXPECT_TRUE(none.list().empty());
+
+    // Loading: a missing grid is the asset's fieldName's fault, an unreadable file its filePath's.
+    Diagnostics load;
+    GridMediumDesc good = *g;
+    good.temperatureGrid.clear();
+    EXPECT_TRUE(loadGridMediumReported("/V", "/V/density", good, load));
+    EXPECT_TRUE(load.list().empty());
+    GridMediumDesc missingGrid = good;
+    missingGrid.densityGrid = "smoke";
+    EXPECT_FALSE(loadGridMediumReported("/V", "/V/density", missingGrid, load));
+    EXPECT_TRUE(hasDiagnostic(load, Severity::Error, "fieldName"));
+    GridMediumDesc missingFile = good;
+    missingFile.filePath = (dir / "absent.vdb").string();
+    Diagnostics load2;
+    EXPECT_FALSE(loadGridMediumReported("/V", "/V/density", missingFile, load2));
+    EXPECT_TRUE(hasDiagnostic(load2, Severity::Error, "filePath"));
 }
 
 TEST(TranslateLight, BlackbodyIsWhiteAt6500KAndWarmBelow) {

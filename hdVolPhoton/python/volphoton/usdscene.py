@@ -95,7 +95,6 @@ Camera (UsdGeomCamera; apertures and focal length in tenths of a scene unit)
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -105,7 +104,6 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdLux, UsdRender, UsdShade, UsdVol
 from . import _core
 from . import presets as vpresets
 from . import schema as vschema
-from . import vdbguard
 from .schema import Diagnostic
 
 __all__ = [
@@ -843,44 +841,18 @@ class _Translator:
             self.extend_bounds(np.array(b))
 
     def _grid_medium(self, prim: Usd.Prim, md: vschema.MediumDesc, world: np.ndarray):
+        """The grid medium from the volume's OpenVDBAsset fields: which grid of which file each slot
+        names, and the guarded load, are the translation layer's (core/translate/volume.h)."""
         path = str(prim.GetPath())
-        dens = md.fields.get("density")
-        if dens is None or not dens.file_path:
-            return None  # read_medium reported why
-        gd, diags = _core.grid_medium_desc(md.core, world)  # every medium parameter (core/translate)
+        fields = [_core.GridFieldInput(slot, f.prim_path, f.file_path, f.field_name, f.field_index)
+                  for slot, f in md.fields.items()]
+        gd, diags = _core.grid_medium_from_fields(path, md.core, world, fields, self.max_grid_voxels)
         self.diags.extend(vschema.diagnostics_from_core(diags))
-        gd.file_path = dens.file_path
-        gd.density_grid = dens.field_name or "density"
-        if dens.field_index >= 0:
-            self.d.warn(dens.prim_path, "fieldIndex", "fieldIndex is ignored; the grid is selected by fieldName "
-                        "'%s'" % gd.density_grid)
-        for fname, attr in (("emission", "emission_grid"), ("temperature", "temperature_grid"), ("albedo", "albedo_grid")):
-            f = md.fields.get(fname)
-            if f is None or not f.file_path:
-                continue
-            if os.path.realpath(f.file_path) != os.path.realpath(dens.file_path):
-                self.d.error(f.prim_path, "filePath", "field:%s of %s is in %s but the density field is in %s; every "
-                             "field must come from the density's file; field ignored"
-                             % (fname, path, f.file_path, dens.file_path))
-                continue
-            setattr(gd, attr, f.field_name or fname)
-        gd.max_active_voxels = self.max_grid_voxels
-        problem = vdbguard.crash_check_medium(gd)
-        if problem:
-            self.d.error(dens.prim_path, "filePath", "field:density of %s (file %s): %s; volume skipped"
-                         % (path, dens.file_path, problem))
-            return None
-        try:
-            return _core.load_grid_medium(gd)
-        except (RuntimeError, ValueError) as e:
-            msg = str(e)
-            readable = os.path.isfile(dens.file_path) and os.access(dens.file_path, os.R_OK)
-            grid_problem = readable and ("grid" in msg.lower()) and "cannot read" not in msg.lower() \
-                and "cannot open" not in msg.lower()
-            attr = "fieldName" if grid_problem else "filePath"
-            self.d.error(dens.prim_path, attr, "field:density of %s (file %s, grid '%s'): %s; volume skipped"
-                         % (path, dens.file_path, gd.density_grid, msg))
-            return None
+        if gd is None:
+            return None  # read_medium reported why there is no density file
+        medium, diags = _core.load_grid_medium_reported(path, md.fields["density"].prim_path, gd)
+        self.diags.extend(vschema.diagnostics_from_core(diags))
+        return medium
 
     # -- point instancers --------------------------------------------------------------------------
     def point_instancer(self, prim: Usd.Prim) -> None:
