@@ -11,11 +11,13 @@
    parameters: sigma_t from 0 to 1e7 per scene unit, HG g = +-0.9999, albedo 0 and 1, scene scales
    1e-4 and 1e5, thin slivers, grazing camera rays, overlapping media (homogeneous + exponential +
    grid), lights inside dense media, media inside dielectrics, a camera inside media, extreme
-   exponential profiles and VDB density scales.  Checks per render:
+   exponential profiles and VDB density scales, scene extents 1e-3..1e7, emissive geometry (a
+   furnace inside an emissive enclosure at every scale, a tiny emitter of radiance 1e12, degenerate
+   emissive triangles, an emitter grazing a floor).  Checks per render:
      * every AOV pixel finite, beauty >= 0;
      * no sample dropped by the renderer's non-finite/negative guard (integrator.cpp reports each
        through the diagnostic sink; the film stays clean, so this catches NaNs the film hides);
-     * furnace bound: in scenes lit only by a dome of radiance L with non-emissive media and
+     * furnace bound: in scenes lit only by a dome (or an enclosing emitter) of radiance L with non-emissive media and
        surfaces of albedo <= 1, no pixel mean exceeds L beyond its noise (6 standard errors from the
        per-pass means, + 2% for estimator bias), nor does the image mean (4 standard errors + 1%, and
        never more than 1.25 L whatever the noise: spikes must not hide an energy gain);
@@ -156,6 +158,15 @@ def generated_cases(long: bool):
     for extent in SCENE_EXTENTS:
         for sig in (1.0, 1e3):
             add("scale", extent=extent, sigma=sig, albedo=1.0, g=0.5, scale=1.0, depth=None)  # the default
+    # M. emissive geometry (issue 14): a white furnace inside an inward-facing emissive sphere
+    # (radiance L, albedo 0) filled with an albedo-1 medium, at every scale; and emitters at extremes
+    # (a tiny sphere of radiance 1e12, a mesh of mostly zero-area triangles, an emitter grazing a floor).
+    for sc in SCALES:
+        for sig in (1e-3, 1.0, 1e3):
+            for g in (0.0, 0.9999):
+                add("emissive", sigma=sig, albedo=1.0, g=g, scale=sc, depth=None)
+    for what in ("tiny_bright", "degenerate", "grazing"):
+        add("emissive_extreme", what=what, scale=1.0, depth=64)
     for i, c in enumerate(cases):
         c["id"] = i
     if long:
@@ -165,7 +176,8 @@ def generated_cases(long: bool):
     box = [c for c in cases if c["kind"] == "box"]
     # The grid at density scales >= 1e5 takes minutes per pass (null collisions in coarse majorant
     # cells; see the long form's report): the long form only.
-    others = [c for c in cases if c["kind"] not in ("box", "scale") and not (c["kind"] == "grid" and c["density"] >= 1e5)]
+    others = [c for c in cases if c["kind"] not in ("box", "scale", "emissive", "emissive_extreme")
+              and not (c["kind"] == "grid" and c["density"] >= 1e5)]
     by_kind = {}
     for c in others:
         by_kind.setdefault(c["kind"], []).append(c)
@@ -174,6 +186,10 @@ def generated_cases(long: bool):
         pick += rnd.sample(lst, min(3, len(lst)))
     # the extreme scene extents (not drawn: the draws of the other kinds stay as they were)
     pick += [c for c in cases if c["kind"] == "scale" and c["extent"] in (1e-3, 1e7) and c["sigma"] == 1.0]
+    # emissive geometry: the extreme scales at optical size 1, and the extreme emitters
+    pick += [c for c in cases if c["kind"] == "emissive" and c["scale"] in (1e-4, 1e5) and c["sigma"] == 1.0
+             and c["g"] == 0.0]
+    pick += [c for c in cases if c["kind"] == "emissive_extreme"]
     # always the most extreme boxes
     pick += [c for c in box if c["sigma"] == 1e7 and c["albedo"] == 1.0 and c["g"] == 0.9999 and c["scale"] == 1e-4]
     seen, out = set(), []
@@ -200,7 +216,8 @@ def _box_mesh(core, lo, hi, material, interior=-1, name="box"):
     return m
 
 
-def _sphere_mesh(core, center, radius, material, interior=-1, seg=24, rings=12):
+def _sphere_mesh(core, center, radius, material, interior=-1, seg=24, rings=12, inward=False):
+    """A UV sphere; its triangles' winding faces out, or in when `inward`."""
     import numpy as np
 
     pts = [(0.0, 1.0, 0.0)]
@@ -225,7 +242,7 @@ def _sphere_mesh(core, center, radius, material, interior=-1, seg=24, rings=12):
     m = core.MeshDesc()
     m.name = "sphere"
     m.points = np.asarray(pts) * radius + np.asarray(center, float)
-    m.indices = np.asarray(tris).reshape(-1)
+    m.indices = np.asarray([t[::-1] for t in tris] if inward else tris).reshape(-1)
     m.material = material
     m.interior_medium = interior
     return m
@@ -256,7 +273,7 @@ def build_case(core, case, vdb_path):
     d = core.SceneDesc()
     boundary = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Boundary)
     L = 1.0
-    furnace = True
+    furnace, add_dome = True, True
     g = case.get("g", 0.0)
     phase = core.henyey_greenstein_phase(g)
 
@@ -358,6 +375,45 @@ def build_case(core, case, vdb_path):
         d.add_instance(mesh, np.eye(4))
         cam.camera_to_world = _look_at(tuple(c0 + np.array([0.8, 0.5, 1.6]) * size), tuple(c0))
         cam.near_clip = 1e-3 * size
+    elif kind == "emissive":
+        # Furnace: inside an emitter of radiance L that faces in and reflects nothing, an albedo-1
+        # medium sees radiance L everywhere. The camera at the centre, no dome.
+        furnace, add_dome = True, False
+        glow = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.0, 0.0, 0.0),
+                                    emission=(L, L, L))
+        d.add_instance(d.add_mesh(_sphere_mesh(core, (0, 0, 0), 2 * s, glow, inward=True)), np.eye(4))
+        med = core.HomogeneousMedium(coeffs(case["sigma"] / s, 1.0))
+        mi = d.add_medium(med, False)
+        d.add_instance(d.add_mesh(_box_mesh(core, (-s, -s, -s), (s, s, s), boundary, mi)), np.eye(4))
+        cam.camera_to_world = _look_at((0.1 * s, 0.2 * s, 1.5 * s), (0, 0, 0))
+    elif kind == "emissive_extreme":
+        furnace = False
+        grey = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.7, 0.7, 0.7))
+        d.add_instance(d.add_mesh(_box_mesh(core, (-2, -1.2, -2), (2, -1, 2), grey, name="floor")), np.eye(4))
+        med = core.HomogeneousMedium(coeffs(1.0, 0.9))
+        mi = d.add_medium(med, False)
+        d.add_instance(d.add_mesh(_box_mesh(core, (-0.8, -0.9, -0.8), (0.8, 0.7, 0.8), boundary, mi)), np.eye(4))
+        w = case["what"]
+        if w == "tiny_bright":
+            hot = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.0, 0.0, 0.0),
+                                       emission=(1e12, 1e12, 1e12))
+            d.add_instance(d.add_mesh(_sphere_mesh(core, (0.1, 0.2, 0.0), 1e-6, hot)), np.eye(4))
+        elif w == "degenerate":
+            glow = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.5, 0.5, 0.5),
+                                        emission=(5.0, 5.0, 5.0))
+            m = core.MeshDesc()
+            m.name = "degenerate"
+            m.points = np.array([[0, 1, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0], [0, 1, 1], [1, 1, 0.5]], float)
+            m.indices = np.array([0, 1, 2, 0, 2, 3, 0, 4, 2, 0, 2, 4])  # zero area, collinear, then a pair
+            m.material = glow
+            d.add_instance(d.add_mesh(m), np.eye(4))
+        elif w == "grazing":
+            glow = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.0, 0.0, 0.0),
+                                        emission=(3.0, 3.0, 3.0))
+            # A panel lying 1e-7 above the floor, facing up: light at grazing angles to the floor.
+            d.add_instance(d.add_mesh(_box_mesh(core, (-1, -1 + 1e-7, -1), (1, -1 + 2e-7, 1), glow, name="panel")),
+                           np.eye(4))
+        L = None
     elif kind == "lights":
         furnace = False
         grey = core.SurfaceMaterial(kind=core.SurfaceMaterial.Kind.Lambertian, albedo=(0.7, 0.7, 0.7))
@@ -380,7 +436,7 @@ def build_case(core, case, vdb_path):
         L = None
     else:
         raise ValueError(kind)
-    if furnace:
+    if furnace and add_dome:
         d.add_light(core.dome_light((L, L, L)))
     d.camera = cam
     return d, (L if furnace else None)
@@ -449,12 +505,12 @@ def run_case(core, case, vdb_path, integrator, passes, size=(8, 6)):
                 # Spikes large enough to hide an energy gain in their own standard error are a failure too.
                 res["failures"].append("furnace: image mean %.6g > 1.25 L = %g (per-pass image means %s)" % (
                     beauty.mean(), 1.25 * L, ", ".join("%.3g" % m for m in img_means)))
-            # Scale cases, optical size 1: the path tracer at its default depth must not lose energy
+            # Scale and emissive cases, optical size 1: the path tracer at its default depth must not lose energy
             # either. (Not at optical size 1e3: albedo-1 walks there take ~1e6 events, the deep
             # roulette ends them with heavy-tailed weights, and 6 passes' standard error does not
             # bound the shortfall of a skewed mean. Not the photon map: its dome photons are spread
             # over the scene's disk, so few reach an object 1e-4 of the scene, low at every extent.)
-            if (case["kind"] == "scale" and integrator == "pathTracer" and case["sigma"] <= 1.0
+            if (case["kind"] in ("scale", "emissive") and integrator == "pathTracer" and case["sigma"] <= 1.0
                     and beauty.mean() < L * 0.98 - 4 * se):
                 res["failures"].append("furnace: image mean %.6g < L = %g (-4 se %.3g, -2%%)" % (beauty.mean(), L, 4 * se))
             res["furnace_ratio"] = float(beauty.mean() / L)

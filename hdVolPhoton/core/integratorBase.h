@@ -136,6 +136,13 @@ protected:
     /// for one light picked by power. With `mis`, lights with extent are weighted by the power
     /// heuristic against cosine sampling (the path tracer); without, light sampling stands alone.
     Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
+    /// Radiance an emissive lambertian surface sends back along ray.d (from its front face, the side
+    /// hit.ng points to), else black. The camera paths add it at their hits (weighted: emissive
+    /// meshes are lights too, Scene::instanceLight).
+    Spectrum surfaceEmission(const Ray& ray, const SurfaceHit& hit) const;
+    /// Density (pick probability times solid angle) with which sampleDirect() from `from` produces
+    /// the emitter point of `hit`: 0 when the hit's instance is not a mesh light. For MIS at hits.
+    double emitterDensity(const Vec3& from, const SurfaceHit& hit) const;
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
     /// The surface, light and hole a camera path meets next along path.ray (surfaces in [tMin, tMax];
@@ -143,12 +150,12 @@ protected:
     PathSegment nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay) const;
     /// A camera path at a surface hit, shared by both integrators' Li(). An index-matched boundary is
     /// crossed (the stack toggled; Stop past MaxBoundaryCrossings). Any other surface is a vertex:
-    /// the front face of an emissive lambertian surface adds beta * emission; past settings.maxDepth
-    /// the path stops; else a lambertian surface adds its next-event estimate (directAtLambertian
-    /// with `mis`) and the surface is sampled (scatterSurface, radiance mode): Stop when absorbed,
-    /// else beta *= the sample's weight and the path bounces -> Bounced, the sample in *scatter.
-    /// `add` receives beta * emission and the direct estimate, in that order (the caller routes them
-    /// to its AOVs). Random numbers: directAtLambertian's, then scatterSurface's.
+    /// past settings.maxDepth the path stops; else a lambertian surface adds its next-event estimate
+    /// (directAtLambertian with `mis`) and the surface is sampled (scatterSurface, radiance mode):
+    /// Stop when absorbed, else beta *= the sample's weight and the path bounces -> Bounced, the
+    /// sample in *scatter. `add` receives beta * the direct estimate (the caller routes it to its
+    /// AOVs; the hit's own emission is the caller's, surfaceEmission). Random numbers:
+    /// directAtLambertian's, then scatterSurface's.
     SurfaceStep cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, MediumStack& stack, Spectrum& beta, int& depth,
                                  int& crossings, Rng& rng, bool mis, FunctionRef<void(const Spectrum&)> add,
                                  SurfaceScatter* scatter) const;

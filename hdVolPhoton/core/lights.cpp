@@ -8,6 +8,7 @@
 
 #include "core/diagnostics.h"
 #include "core/sampling.h"
+#include "core/scene.h"
 
 namespace volphoton {
 
@@ -240,6 +241,86 @@ private:
     double area_;
 };
 
+class MeshLight final : public Light {
+public:
+    MeshLight(std::string name, std::vector<Vec3> points, const std::vector<uint32_t>& indices, const Spectrum& L)
+        : name_(std::move(name)), points_(std::move(points)), L_(L) {
+        requireFinite(L, "mesh light");
+        std::vector<double> areas;
+        for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+            const Vec3 &a = points_[indices[t]], &b = points_[indices[t + 1]], &c = points_[indices[t + 2]];
+            Vec3 n = cross(b - a, c - a);
+            double area = 0.5 * length(n);
+            if (!(area > 0) || !std::isfinite(area)) continue;
+            triangles_.push_back({indices[t], indices[t + 1], indices[t + 2], n / (2 * area)});
+            areas.push_back(area);
+            area_ += area;
+        }
+        if (!triangles_.empty()) triangleDist_ = Distribution1D(areas);
+    }
+    bool empty() const { return triangles_.empty(); }
+
+    /// A point uniform over the area and its triangle's unit normal; u1 picks the triangle and is
+    /// reused (rescaled) inside it.
+    std::pair<Vec3, Vec3> pointAt(double u1, double u2) const {
+        double pdf;
+        size_t i;
+        double x = triangleDist_.sample(u1, &pdf, &i);
+        double v = std::clamp(x * triangles_.size() - static_cast<double>(i), 0.0, 1.0);
+        const Triangle& tri = triangles_[i];
+        double su = std::sqrt(v), b0 = 1 - su, b1 = u2 * su;  // uniform barycentrics (pbrt's)
+        return {points_[tri.a] * b0 + points_[tri.b] * b1 + points_[tri.c] * (1 - b0 - b1), tri.n};
+    }
+    LightSample sample(const Vec3& ref, double u1, double u2) const override {
+        LightSample s;
+        auto [p, n] = pointAt(u1, u2);
+        Vec3 d = p - ref;
+        double dist2 = lengthSquared(d), dist = std::sqrt(dist2);
+        if (!(dist > 0)) return s;
+        s.wi = d / dist;
+        double cosL = -dot(s.wi, n);
+        if (!(cosL > 0)) return s;
+        // Short of the emitter by its float precision along the ray, so that the shadow ray does not
+        // meet the emitting triangle itself (shadowTransmittance stops short by the unslanted bound).
+        s.dist = std::max(0.0, dist - Scene::floatError(p) / std::max(cosL, Scene::MinSpawnCos));
+        s.Li = L_;
+        s.pdf = dist2 / (cosL * area_);
+        return s;
+    }
+    bool intersect(const Ray&, double, double*, Spectrum*, double*) const override { return false; }
+    double pdfAt(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
+        Vec3 d = p - ref;
+        double dist2 = lengthSquared(d);
+        double cosL = -dot(d, n) / std::sqrt(dist2);
+        return cosL > 0 && dist2 > 0 ? dist2 / (cosL * area_) : 0.0;
+    }
+    bool isDelta() const override { return false; }
+    Spectrum power(double) const override { return L_ * (Pi * area_); }
+    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+        auto [p, n] = pointAt(u[0], u[1]);
+        Vec3 d = Frame::fromZ(n).toWorld(cosineHemisphere(u[2], u[3]));
+        // Off the surface by its float precision, so that the photon's first ray does not meet it.
+        return {{p + n * (4 * Scene::floatError(p)), d}, L_ * (Pi * area_)};
+    }
+    std::string describe() const override {
+        std::ostringstream o;
+        o << "mesh light '" << name_ << "' (" << triangles_.size() << " triangles, area " << area_ << ")";
+        return o.str();
+    }
+
+private:
+    struct Triangle {
+        uint32_t a, b, c;
+        Vec3 n;  ///< unit geometric normal, (b - a) x (c - a)
+    };
+    std::string name_;
+    std::vector<Vec3> points_;
+    std::vector<Triangle> triangles_;
+    Distribution1D triangleDist_;
+    Spectrum L_;
+    double area_ = 0;
+};
+
 class DomeLight final : public Light {
 public:
     DomeLight(const Spectrum& L, LatLongImage img, const Affine& toWorld) : L_(L), img_(std::move(img)), toWorld_(toWorld) {
@@ -382,6 +463,12 @@ LightPtr makeRectLight(const Affine& m, double w, double h, const Spectrum& L) {
 LightPtr makeDiskLight(const Affine& m, double r, const Spectrum& L) { return std::make_shared<PlanarLight>(m, true, r, r, L); }
 LightPtr makeDomeLight(const Spectrum& L, LatLongImage image, const Affine& m) {
     return std::make_shared<DomeLight>(L, std::move(image), m);
+}
+
+LightPtr makeMeshLight(const std::string& name, std::vector<Vec3> points, const std::vector<uint32_t>& indices,
+                       const Spectrum& radiance) {
+    auto light = std::make_shared<MeshLight>(name, std::move(points), indices, radiance);
+    return light->empty() ? nullptr : light;
 }
 
 }  // namespace volphoton

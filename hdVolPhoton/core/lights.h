@@ -9,6 +9,12 @@
 // | rect     | lightToWorld, width, height                  | radiance L, emitted towards local -Z      |
 // | disk     | lightToWorld, radius                         | radiance L, emitted towards local -Z      |
 // | dome     | constant radiance or lat-long RGB texture    | radiance L(direction)                     |
+// | mesh     | world-space triangles (an emissive mesh)     | radiance L from the front side (+normal)  |
+//
+// Mesh lights are the scene's emissive geometry (SurfaceMaterial::emission), made by the Scene for
+// every emissive mesh instance: sampled uniformly by area for next-event estimation and photon
+// emission. They are surfaces in the BVH, so paths find them by surface hits (intersect() is false)
+// and weight those with pdfAt().
 #pragma once
 
 #include <memory>
@@ -56,6 +62,13 @@ public:
     /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
     virtual Spectrum power(double sceneRadius) const = 0;
     virtual PhotonEmission emitPhoton(const Vec3& sceneCenter, double sceneRadius, double u[4]) const = 0;
+    /// Lights that are scene geometry (mesh lights): the solid-angle density with which sample(ref)
+    /// produces the point p on the light, whose geometric normal is n (for MIS at surface hits).
+    /// 0 for every other light (their hits come from intersect()).
+    virtual double pdfAt(const Vec3& ref, const Vec3& p, const Vec3& n) const {
+        (void)ref, (void)p, (void)n;
+        return 0;
+    }
     virtual std::string describe() const = 0;
 };
 
@@ -78,6 +91,12 @@ LightPtr makeRectLight(const Affine& lightToWorld, double width, double height, 
 LightPtr makeDiskLight(const Affine& lightToWorld, double radius, const Spectrum& radiance);
 /// Dome: constant radiance, or radiance * texture when the image is non-empty. worldToLight orients it.
 LightPtr makeDomeLight(const Spectrum& radiance, LatLongImage image = {}, const Affine& lightToWorld = {});
+
+/// Emissive triangles (world space; indices in threes) of radiance L leaving the front side (the
+/// side the counter-clockwise winding's normal points to). Degenerate triangles are ignored; nullptr
+/// when no triangle has area. Throws std::invalid_argument for negative or non-finite L.
+LightPtr makeMeshLight(const std::string& name, std::vector<Vec3> points, const std::vector<uint32_t>& indices,
+                       const Spectrum& radiance);
 
 /// UsdLux ShapingAPI cone falloff: 1 inside coneAngle*(1-softness), smoothstep to 0 at coneAngle.
 double spotFalloff(double cosAngle, double coneAngle, double coneSoftness);

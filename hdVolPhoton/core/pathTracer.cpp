@@ -12,7 +12,7 @@
 // collision as beta * emission / sigma_maj (pbrt-v4's VolPathIntegrator does the same).
 // Direct light: next-event estimation with shadow transmittance (closed form where the media have one,
 // else ratio tracking), combined with phase/BSDF sampling by MIS (power heuristic) for lights with
-// extent. Point, spot and sphere lights add a second strategy on every segment in a medium:
+// extent, emissive meshes included (Scene::instanceLight: their hits are weighted by emitterDensity). Point, spot and sphere lights add a second strategy on every segment in a medium:
 // equiangular sampling of the distance towards the light's centre (Kulla and Fajardo 2012),
 // combined with the NEE at real collisions by one-sample MIS over distance (balance heuristic
 // against the free-flight density). For sphere lights the light-sampled half of the direction MIS
@@ -46,6 +46,7 @@ public:
         Branch branch = Branch::Undecided;
         bool specular = true;  // the previous vertex cannot be light-sampled (camera, mirror, refraction)
         double prevPdf = 0;
+        Vec3 prevVertex;  // the last scattering vertex (for the light-sampling density of emitter hits)
         int depth = 0, crossings = 0;
         bool firstSegment = true;
         bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
@@ -142,6 +143,7 @@ public:
                 if (!(pdf > 0)) break;
                 beta *= mp.scatterKernel(cosTheta) / pdf;
                 prevPdf = pdf;
+                prevVertex = p;
                 specular = false;
                 path.bounce({p, w}, 0.0);
                 firstSegment = false;
@@ -164,6 +166,13 @@ public:
             }
             if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;
+            // An emissive mesh is a light too: its hit is weighted against sampling it from the
+            // previous vertex (power heuristic), as lights with extent are above.
+            Spectrum Le = surfaceEmission(ray, ahead.hit);
+            if (!Le.isBlack()) {
+                double w = specular ? 1.0 : powerHeuristic(prevPdf, emitterDensity(prevVertex, ahead.hit));
+                add(beta * Le * w, lightWasSingle);
+            }
             // Surface light goes to `surface` when the surface is the first vertex (branch Undecided
             // or Surface), else to `multiple`.
             SurfaceScatter s;
@@ -174,6 +183,7 @@ public:
             if (branch == Branch::Undecided) branch = Branch::Surface;
             specular = s.type == SurfaceScatter::Type::Specular;
             if (!specular) prevPdf = std::abs(dot(s.next.d, ahead.hit.ns)) * InvPi;
+            prevVertex = ahead.hit.p;
             firstSegment = false;
             if (!roulette(beta, depth, rng)) break;
         }

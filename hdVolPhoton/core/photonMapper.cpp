@@ -126,6 +126,10 @@ public:
             }
             if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;
+            // Emissive meshes are lights too (light-sampled at diffuse vertices, Scene::instanceLight),
+            // so, as for lights above, their hits count only after the camera or specular bounces.
+            if (onlySpecular || scene_.instanceLight(ahead.hit.instance) < 0)
+                out.surface += beta * surfaceEmission(ray, ahead.hit);
             SurfaceScatter s;
             SurfaceStep step = cameraSurfaceHit(path, ahead.hit, stack, beta, depth, crossings, rng, /*mis=*/false,
                                                 [&](const Spectrum& L) { out.surface += L; }, &s);

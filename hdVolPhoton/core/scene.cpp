@@ -36,6 +36,37 @@ bool isClosedMesh(const std::vector<uint32_t>& indices) {
 }
 }  // namespace
 
+void Scene::addMeshLights() {
+    // Every instance of an emissive lambertian mesh is a light (uniform over its area): next-event
+    // estimation and photon emission find it like any other light, chosen by power with them.
+    instanceLight_.assign(desc_.instances.size(), -1);
+    if (!desc_.emissiveMeshLights) return;
+    for (size_t ii = 0; ii < desc_.instances.size(); ++ii) {
+        const InstanceDesc& inst = desc_.instances[ii];
+        const MeshDesc& m = desc_.meshes[inst.mesh];
+        if (m.material.kind != SurfaceMaterial::Kind::Lambertian || m.material.emission.isBlack()) continue;
+        if (!inst.transform.inverse()) continue;  // skipped above, with a warning
+        std::vector<Vec3> world;
+        world.reserve(m.points.size());
+        for (const Vec3& p : m.points) world.push_back(inst.transform.point(p));
+        // The emitting side is the one SurfaceHit::ng points to (the object-space winding's normal
+        // carried by the inverse transpose): a mirroring transform reverses the world winding.
+        std::vector<uint32_t> indices = m.indices;
+        if (inst.transform.determinant() < 0)
+            for (size_t t = 0; t + 2 < indices.size(); t += 3) std::swap(indices[t + 1], indices[t + 2]);
+        LightPtr light;
+        try {
+            light = makeMeshLight(m.name, std::move(world), indices, m.material.emission);
+        } catch (const std::exception& e) {
+            warn("mesh '" + m.name + "': " + e.what() + "; its emission is not sampled as a light");
+            continue;
+        }
+        if (!light) continue;  // no triangle with area: it cannot be hit either
+        instanceLight_[ii] = static_cast<int>(desc_.lights.size());
+        desc_.lights.push_back(std::move(light));
+    }
+}
+
 Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw std::runtime_error("cannot create an Embree device");
@@ -109,6 +140,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         }
     }
     rtcCommitScene(top_);
+    addMeshLights();
 
     for (int i : desc_.unboundedMedia) {
         if (i < 0 || i >= static_cast<int>(desc_.media.size())) throw std::invalid_argument("scene: unbounded medium index out of range");

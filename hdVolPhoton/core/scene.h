@@ -63,6 +63,11 @@ struct SceneDesc {
     std::vector<int> unboundedMedia;
     std::vector<LightPtr> lights;
     CameraDesc camera;
+    /// Every instance of an emissive lambertian mesh becomes a light (Scene::instanceLight). false:
+    /// emissive meshes are found by hits only, as before they were lights: a baseline for
+    /// tools/bench_emissive.py (the path tracer is unbiased either way; the photon map then has no
+    /// photons from them).
+    bool emissiveMeshLights = true;
 };
 
 struct SurfaceHit {
@@ -126,7 +131,10 @@ public:
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
     /// Whether mesh i is topologically closed (every edge shared by exactly two triangles).
     bool meshClosed(int i) const { return meshClosed_[i] != 0; }
+    /// The SceneDesc's lights, then one mesh light per instance of an emissive lambertian mesh.
     const std::vector<LightPtr>& lights() const { return desc_.lights; }
+    /// Index in lights() of instance i's mesh light, or -1 when the instance does not emit.
+    int instanceLight(int instance) const { return instance >= 0 ? instanceLight_[instance] : -1; }
 #ifdef VOLPHOTON_NO_VOLUMES
     // Benchmark baseline (CMake option VOLPHOTON_NO_VOLUMES): media are ignored and every
     // `if (scene.hasMedia())` branch of the integrators is dead code the compiler removes.
@@ -172,6 +180,9 @@ private:
     Vec3 center_;
     double radius_ = 1;
     std::vector<char> meshClosed_;
+    std::vector<int> instanceLight_;  ///< per instance: index of its mesh light in lights(), or -1
+
+    void addMeshLights();
 };
 
 }  // namespace volphoton

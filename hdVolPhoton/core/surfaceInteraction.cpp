@@ -1,4 +1,5 @@
-// Surfaces for both integrators: Fresnel reflectance, next-event estimation at lambertian surfaces,
+// Surfaces for both integrators: Fresnel reflectance, emission and its light-sampling density,
+// next-event estimation at lambertian surfaces,
 // sampling a surface's scattering (boundary crossing, lambertian bounce, dielectric reflection or
 // refraction) and the camera paths' whole surface vertex (Integrator::cameraSurfaceHit). Declared in
 // integratorBase.h.
@@ -83,6 +84,17 @@ SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit,
     return s;
 }
 
+Spectrum Integrator::surfaceEmission(const Ray& ray, const SurfaceHit& hit) const {
+    const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+    if (m.kind != SurfaceMaterial::Kind::Lambertian || m.emission.isBlack() || !(dot(ray.d, hit.ng) < 0)) return {};
+    return m.emission;
+}
+
+double Integrator::emitterDensity(const Vec3& from, const SurfaceHit& hit) const {
+    int light = scene_.instanceLight(hit.instance);
+    return light < 0 ? 0.0 : lightPickProb(light) * scene_.lights()[light]->pdfAt(from, hit.p, hit.ng);
+}
+
 SurfaceStep Integrator::cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, MediumStack& stack, Spectrum& beta,
                                          int& depth, int& crossings, Rng& rng, bool mis,
                                          FunctionRef<void(const Spectrum&)> add, SurfaceScatter* scatter) const {
@@ -93,9 +105,6 @@ SurfaceStep Integrator::cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, M
         path.passBoundary(scatterSurface(ray, hit, stack, rng, true), hit.t);
         return SurfaceStep::Crossed;
     }
-    // Emissive meshes are found by hits only (no light sampling).
-    if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.emission.isBlack() && dot(ray.d, hit.ng) < 0)
-        add(beta * m.emission);
     if (++depth > settings_.maxDepth) return SurfaceStep::Stop;
     if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
         add(beta * directAtLambertian(ray, hit, stack, rng, mis));

@@ -219,6 +219,8 @@ void bindScene(py::module_& m) {
             return v;
         }, [](SceneDesc& d, const std::vector<std::shared_ptr<Light>>& v) { d.lights.assign(v.begin(), v.end()); })
         .def_readwrite("camera", &SceneDesc::camera)
+        .def_readwrite("emissive_mesh_lights", &SceneDesc::emissiveMeshLights,
+                       "False: emissive meshes are found by hits only, not sampled as lights (benchmarks)")
         .def("add_mesh", [](SceneDesc& d, const MeshDesc& mesh) {
             d.meshes.push_back(mesh);
             return static_cast<int>(d.meshes.size() - 1);

@@ -405,6 +405,52 @@ def test_grid_fields_follow_one_set_of_rules_in_both_doors(tmp_path, hydra_env):
     assert_doors_agree(hydra, cli, "grid fields from two files")
 
 
+# A fog box under a downward-facing emissive panel (UsdPreviewSurface emissiveColor), the only light.
+EMISSIVE_PANEL = '''    def Cube "medium" (
+        prepend apiSchemas = ["VolPhotonMediumAPI"]
+    )
+    {
+        double size = 1.6
+        float volphoton:density = 1.5
+        color3f volphoton:albedo = (0.9, 0.9, 0.9)
+    }
+
+    def Material "glow"
+    {
+        token outputs:surface.connect = </World/glow/shader.outputs:surface>
+        def Shader "shader"
+        {
+            uniform token info:id = "UsdPreviewSurface"
+            color3f inputs:diffuseColor = (0, 0, 0)
+            color3f inputs:emissiveColor = (2, 1.5, 1)
+            token outputs:surface
+        }
+    }
+
+    def Mesh "panel" (
+        prepend apiSchemas = ["MaterialBindingAPI"]
+    )
+    {
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(-1, 1.5, -1), (1, 1.5, -1), (1, 1.5, 1), (-1, 1.5, 1)]
+        rel material:binding = </World/glow>
+    }
+'''
+
+
+@pytest.mark.parametrize("integrator", ["pathTracer", "photonMap"])
+def test_emissive_geometry_lights_media_in_both_doors(tmp_path, hydra_env, integrator):
+    """An emissive panel (the only light, out of view above the frame) lighting a fog box: both doors
+    sample it as a light (core Scene::instanceLight, issue 14), in both integrators, and agree.  The
+    fog must be lit (the panel is never seen directly: every pixel is scattered light)."""
+    settings = ['token volphoton:integrator = "%s"' % integrator] + ([PHOTONS] if integrator == "photonMap" else [])
+    hydra, cli, _, _ = render_both(hydra_env, tmp_path, "panel_" + integrator,
+                                   lambda s: stage_text(EMISSIVE_PANEL, s, settings=settings))
+    check(cli.mean() > 0.02, "the CLI's fog is not lit by the panel: mean %.4f" % cli.mean())
+    assert_doors_agree(hydra, cli, "fog under an emissive panel (%s)" % integrator)
+
+
 # --------------------------------------------------------------------------------------------------
 # 4. Exponential haze on a Z-up stage
 # --------------------------------------------------------------------------------------------------

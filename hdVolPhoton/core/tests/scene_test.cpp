@@ -98,6 +98,85 @@ TEST(SceneLights, PhotonEmissionCarriesThePower) {
     }
 }
 
+TEST(SceneLights, EmissiveMeshInstancesAreLightsSampledLikeTheirHits) {
+    // An emissive 2x2 square at y = 1 facing down (winding), once as authored and once mirrored
+    // (scale y -1: at y = -1, and the winding's normal, carried by the inverse transpose, faces up).
+    // From ref, each square (distance d = 1) subtends the solid angle
+    //   sum over corners (x, y) relative to ref of +-atan(x y / (d sqrt(x^2 + y^2 + d^2)))
+    // (the rectangle's solid angle by its corners; 2 pi / 3 on the axis). The mesh light's sampler
+    // (1 / pdf) and uniform directions hitting the instance in the BVH (4 pi) both estimate it;
+    // pdfAt() at the hit equals the sample's pdf.
+    SceneDesc d;
+    MeshDesc square;
+    square.name = "panel";
+    square.points = {Vec3(-1, 1, -1), Vec3(1, 1, -1), Vec3(1, 1, 1), Vec3(-1, 1, 1)};
+    square.indices = {0, 1, 2, 0, 2, 3};  // (1,1,-1)-(-1,1,-1) x (1,1,1)-(-1,1,-1) = (2,0,0) x (2,0,2): -Y
+    square.material.albedo = Spectrum(0.0);
+    square.material.emission = Spectrum(2.0);
+    d.meshes.push_back(square);
+    d.instances.push_back({0, Affine()});
+    d.instances.push_back({0, Affine::scale(Vec3(1, -1, 1))});
+    MeshDesc dark = square;  // not emissive: no light
+    dark.material.emission = Spectrum(0.0);
+    d.meshes.push_back(dark);
+    d.instances.push_back({1, Affine::translate(Vec3(0, 0, 5))});
+    d.lights.push_back(makeSphereLight(Vec3(5, 0, 0), 0.0, Spectrum(1.0)));
+    Scene scene(d);
+    ASSERT_EQ(scene.lights().size(), 3u);  // the authored point light, then one per emissive instance
+    EXPECT_EQ(scene.instanceLight(2), -1);
+    const Vec3 ref(0.1, 0.0, -0.2);
+    auto corner = [](double x, double y) { return std::atan(x * y / std::sqrt(x * x + y * y + 1)); };
+    const double omega = corner(1 - ref.x, 1 - ref.z) - corner(-1 - ref.x, 1 - ref.z) - corner(1 - ref.x, -1 - ref.z) +
+                         corner(-1 - ref.x, -1 - ref.z);
+    for (int inst = 0; inst < 2; ++inst) {
+        int li = scene.instanceLight(inst);
+        ASSERT_GE(li, 1);
+        const Light& light = *scene.lights()[li];
+        EXPECT_NEAR(light.power(1)[0], 2.0 * Pi * 4, 1e-9);
+        Rng rng(11);
+        const int n = 200000;
+        double viaSample = 0, viaHits = 0, hits2 = 0, sample2 = 0;
+        for (int i = 0; i < n; ++i) {
+            LightSample ls = light.sample(ref, rng.uniform(), rng.uniform());
+            if (ls.pdf > 0) {
+                viaSample += 1 / ls.pdf / n;
+                sample2 += 1 / (ls.pdf * ls.pdf) / n;
+                SurfaceHit hit;
+                ASSERT_TRUE(scene.intersect({ref, ls.wi}, 0, Infinity, &hit));
+                EXPECT_EQ(hit.instance, inst);
+                EXPECT_LT(ls.dist, hit.t);  // the shadow ray stops short of the emitter
+                EXPECT_NEAR(light.pdfAt(ref, hit.p, hit.ng) / ls.pdf, 1.0, 1e-4);
+                EXPECT_LT(dot(ls.wi, hit.ng), 0);  // the emitting side faces the reference point
+            }
+            Vec3 w = uniformSphere(rng.uniform(), rng.uniform());
+            SurfaceHit hit;
+            if (scene.intersect({ref, w}, 0, Infinity, &hit) && hit.instance == inst) {
+                viaHits += 4 * Pi / n;
+                hits2 += 16 * Pi * Pi / n;
+            }
+        }
+        double se = std::sqrt((hits2 - viaHits * viaHits) / n + (sample2 - viaSample * viaSample) / n);
+        EXPECT_NEAR(viaSample, viaHits, 4 * se) << inst;
+        EXPECT_NEAR(viaSample, omega, 4 * std::sqrt((sample2 - viaSample * viaSample) / n)) << inst;
+        // Photons carry the power and leave from the front side.
+        double flux = 0;
+        for (int i = 0; i < 20000; ++i) {
+            double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+            PhotonEmission e = light.emitPhoton(Vec3(), 10, u);
+            flux += e.flux[0] / 20000;
+            EXPECT_LT(e.ray.d.y * (inst == 0 ? 1 : -1), 0);
+            SurfaceHit self;
+            EXPECT_FALSE(scene.intersect(e.ray, 0, Infinity, &self) && self.instance == inst);
+        }
+        EXPECT_NEAR(flux / light.power(1)[0], 1.0, 1e-9);
+    }
+    // Off: no mesh lights (hits only).
+    d.emissiveMeshLights = false;
+    Scene hitsOnly(d);
+    EXPECT_EQ(hitsOnly.lights().size(), 1u);
+    EXPECT_EQ(hitsOnly.instanceLight(0), -1);
+}
+
 TEST(SceneLights, SpotFalloff) {
     EXPECT_EQ(spotFalloff(1.0, 0.5, 0.2), 1.0);
     EXPECT_EQ(spotFalloff(std::cos(0.6), 0.5, 0.2), 0.0);

@@ -1,0 +1,282 @@
+"""Emissive geometry is a light (issue 14, part 3): a mesh whose UsdPreviewSurface has an
+emissiveColor is sampled by next-event estimation in both integrators (uniform over its area,
+chosen by power with the other lights) and emits photons, through the usd-core front end (the
+delegate's side is testenv/hydra/test_parity.py).
+
+Scenes (all at default settings but resolution and passes):
+  * enclosure vs dome: a 1-unit slab of fog (albedo 0.8) over a black ground, seen from just below
+    it, lit either by a dome of radiance 1 or by an inward-facing emissive sphere of radiance 1
+    around everything.  Inside such a sphere every direction meets radiance 1, exactly as under
+    the dome, so the two pictures are equal; both integrators, against each other too.
+  * white furnace: fog of albedo 1 filling an inward-facing emissive sphere (radiance 1, albedo
+    0): the radiance is 1 everywhere inside, whatever the fog.
+  * slab under an emissive plane: the same slab under a downward-facing emissive square instead of
+    the dome; the path tracer and the photon map must agree.  Before emissive meshes were lights,
+    the photon map returned only the unscattered part here.
+  * light sampling does not change the answer: a small emissive sphere in fog, rendered with its
+    mesh light (next-event estimation + MIS) and with hits only (SceneDesc.emissive_mesh_lights
+    False, the old way): equal means.  The equal-time error of the two is measured by
+    tools/bench_emissive.py, not here.
+
+Tolerance: the image mean of each (seed, pass) is one sample; sigma is the standard error of the
+mean over the seeds x passes; two renders agree when they differ by less than K = 5 combined sigma
+(7 comparisons: a Gaussian exceeds 5 sigma with probability 6e-7 each), and the furnace is within
+K sigma of 1 plus the photon map's kernel allowance stated there.
+"""
+
+import math
+import textwrap
+
+import numpy as np
+import pytest
+
+from conftest import usda
+
+from pxr import Usd  # noqa: E402
+
+from volphoton import _core, usdscene  # noqa: E402
+
+K = 5.0
+RES = 8
+SEEDS = (1, 2, 3)
+PASSES = 16
+INTEGRATORS = ("pathTracer", "photonMap")
+
+
+def sphere_mesh(name, radius, inward, material, segments=24, rings=12, center=(0.0, 0.0, 0.0)):
+    """A UV sphere Mesh prim (usda text) whose front side (counter-clockwise winding, right-handed)
+    faces out, or in when `inward`."""
+    pts, faces = [], []
+    for r in range(rings + 1):
+        th = math.pi * r / rings
+        for s in range(segments):
+            ph = 2 * math.pi * s / segments
+            pts.append((center[0] + radius * math.sin(th) * math.cos(ph), center[1] + radius * math.cos(th),
+                        center[2] + radius * math.sin(th) * math.sin(ph)))
+    for r in range(rings):
+        for s in range(segments):
+            a, b = r * segments + s, r * segments + (s + 1) % segments
+            c, d = a + segments, b + segments
+            quad = [a, b, d, c]  # normal (b - a) x (c - a) points outwards
+            faces.append(quad[::-1] if inward else quad)
+    return textwrap.dedent('''\
+        def Mesh "%s" (
+            prepend apiSchemas = ["MaterialBindingAPI"]
+        )
+        {
+            int[] faceVertexCounts = [%s]
+            int[] faceVertexIndices = [%s]
+            point3f[] points = [%s]
+            rel material:binding = <%s>
+        }
+        ''') % (name, ", ".join("4" for _ in faces), ", ".join(str(i) for f in faces for i in f),
+                ", ".join("(%.9g, %.9g, %.9g)" % p for p in pts), material)
+
+
+def emissive_material(name, emission, diffuse=0.0):
+    return textwrap.dedent('''\
+        def Material "%(n)s"
+        {
+            token outputs:surface.connect = </World/%(n)s/shader.outputs:surface>
+            def Shader "shader"
+            {
+                uniform token info:id = "UsdPreviewSurface"
+                color3f inputs:diffuseColor = (%(d)g, %(d)g, %(d)g)
+                color3f inputs:emissiveColor = (%(e)g, %(e)g, %(e)g)
+                token outputs:surface
+            }
+        }
+        ''') % {"n": name, "e": emission, "d": diffuse}
+
+
+CAMERA = '''def Camera "cam"
+{
+    float focalLength = 50
+    float horizontalAperture = 20
+    float verticalAperture = 20
+    float2 clippingRange = (1e-4, 1e6)
+    double3 xformOp:translate = (0, %(y)g, 0)
+    float3 xformOp:rotateXYZ = (%(rx)g, 0, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
+}
+'''
+
+SLAB = '''def Cube "fog" (
+    prepend apiSchemas = ["VolPhotonMediumAPI"]
+)
+{
+    double size = 1
+    float volphoton:ior = 1
+    float volphoton:density = 1
+    color3f volphoton:albedo = (0.8, 0.8, 0.8)
+    double3 xformOp:translate = (0, 0.5, 0)
+    float3 xformOp:scale = (4, 1, 4)
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+}
+def Mesh "ground"
+{
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 3, 2, 1]
+    point3f[] points = [(-3, -0.02, -3), (3, -0.02, -3), (3, -0.02, 3), (-3, -0.02, 3)]
+    color3f[] primvars:displayColor = [(0, 0, 0)]
+}
+'''
+
+DOME = '''def DomeLight "sky"
+{
+    float inputs:intensity = 1
+}
+'''
+
+# A square at y = 3 facing down (-Y), half-width 8.
+PLANE = '''def Mesh "panel" (
+    prepend apiSchemas = ["MaterialBindingAPI"]
+)
+{
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 1, 2, 3]
+    point3f[] points = [(-8, 3, -8), (8, 3, -8), (8, 3, 8), (-8, 3, 8)]
+    rel material:binding = </World/glow>
+}
+'''
+
+
+def stage_file(tmp_path, name, body):
+    path = tmp_path / (name + ".usda")
+    text = '#usda 1.0\n(\n    upAxis = "Y"\n)\n' + 'def Xform "World"\n{\n' + textwrap.indent(body, "    ") + "}\n"
+    path.write_text(usda(text))
+    return str(path)
+
+
+def pass_means(path, integrator, emissive_mesh_lights=True, seeds=SEEDS, passes=PASSES):
+    """Image mean (RGB average) of every pass over the seeds, at default settings."""
+    stage = Usd.Stage.Open(path)
+    sc = usdscene.translate(stage, Usd.TimeCode.Default(), RES, RES, "/World/cam")
+    assert not sc.errors, "\n".join(map(str, sc.errors))
+    sc.desc.emissive_mesh_lights = emissive_mesh_lights
+    scene = _core.Scene(sc.desc)
+    out = []
+    for seed in seeds:
+        s = _core.RenderSettings()
+        s.width = s.height = RES
+        s.samples_per_pixel = passes
+        s.seed = seed
+        if integrator == "photonMap":
+            s.integrator = _core.RenderSettings.Integrator.PhotonMap
+        r = _core.Renderer(scene, s)
+        prev = 0.0
+        for k in range(1, passes + 1):
+            assert r.render_pass()
+            img = r.film.beauty.astype(np.float64)
+            assert np.isfinite(img).all()
+            cum = float(img.mean()) * k
+            out.append(cum - prev)
+            prev = cum
+    v = np.array(out)
+    return v.mean(), v.std(ddof=1) / math.sqrt(len(v))
+
+
+def assert_agree(a, b, what):
+    (ma, sa), (mb, sb) = a, b
+    tol = K * math.hypot(sa, sb)
+    print("%s: %.5f +- %.5f vs %.5f +- %.5f" % (what, ma, sa, mb, sb))
+    assert abs(ma - mb) <= tol, "%s: %.5f +- %.5f vs %.5f +- %.5f (tolerance %.5f)" % (what, ma, sa, mb, sb, tol)
+
+
+BELOW = CAMERA % {"y": -0.01, "rx": 90}  # just under the slab, looking up
+
+
+@pytest.fixture(scope="module")
+def slab_renders(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("emissive")
+    dome = stage_file(tmp, "dome", BELOW + SLAB + DOME)
+    enclosure = stage_file(tmp, "enclosure", BELOW + SLAB + emissive_material("glow", 1.0) +
+                           sphere_mesh("enclosure", 6.0, True, "/World/glow"))
+    plane = stage_file(tmp, "plane", BELOW + SLAB + emissive_material("glow", 1.0) + PLANE)
+    out = {}
+    for integrator in INTEGRATORS:
+        out["dome", integrator] = pass_means(dome, integrator)
+        out["enclosure", integrator] = pass_means(enclosure, integrator)
+        out["plane", integrator] = pass_means(plane, integrator)
+    return out
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_an_emissive_enclosure_lights_a_slab_as_a_dome_of_equal_radiance(slab_renders, integrator):
+    m, _ = slab_renders["dome", integrator]
+    assert 0.3 < m < 0.95, m  # e^-1 of the sky plus the light the slab scatters forward
+    assert_agree(slab_renders["enclosure", integrator], slab_renders["dome", integrator],
+                 "%s: emissive enclosure vs dome" % integrator)
+
+
+@pytest.mark.parametrize("scene", ("enclosure", "plane"))
+def test_both_integrators_agree_under_emissive_geometry(slab_renders, scene):
+    # Under the plane the slab sees radiance 1 over most of its upper hemisphere (the square's edges
+    # are 2 to 3 units above it, 8 across): far more than the e^-1 = 0.37 of the bare panel, which
+    # is all the photon map returned when emissive meshes were no lights.
+    m, _ = slab_renders[scene, "pathTracer"]
+    assert m > 0.45, m
+    assert_agree(slab_renders[scene, "photonMap"], slab_renders[scene, "pathTracer"],
+                 "%s: photon map vs path tracer" % scene)
+
+
+FURNACE = CAMERA % {"y": 0, "rx": 0} + '''def Cube "fog" (
+    prepend apiSchemas = ["VolPhotonMediumAPI"]
+)
+{
+    double size = 5
+    float volphoton:ior = 1
+    float volphoton:density = 4
+    color3f volphoton:albedo = (1, 1, 1)
+}
+'''
+
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_white_furnace_inside_an_emissive_enclosure(tmp_path, integrator):
+    """Fog of albedo 1 (mean free path 0.25) filling an emissive sphere of radius 2 (radiance 1,
+    albedo 0) that faces in: radiance 1 everywhere inside.  The photon map's kernel (radius 1/100 of
+    the scene, 0.087 here) loses photons where it reaches past the enclosure's wall; the camera sees
+    into the fog about 4 mean free paths from the wall, where that is below 0.5%: allowance 0.005
+    on top of K sigma for the photon map, none for the path tracer."""
+    path = stage_file(tmp_path, "furnace", FURNACE + emissive_material("glow", 1.0) +
+                      sphere_mesh("enclosure", 2.0, True, "/World/glow"))
+    m, se = pass_means(path, integrator)
+    allowance = 0.005 if integrator == "photonMap" else 0.0
+    print("%s furnace: %.5f +- %.5f" % (integrator, m, se))
+    assert abs(m - 1.0) <= K * se + allowance, (m, se)
+
+
+SMALL_SPHERE = CAMERA % {"y": 0, "rx": 0} + '''def Cube "fog" (
+    prepend apiSchemas = ["VolPhotonMediumAPI"]
+)
+{
+    double size = 6
+    float volphoton:ior = 1
+    float volphoton:density = 0.3
+    color3f volphoton:albedo = (0.9, 0.9, 0.9)
+}
+def Mesh "floor"
+{
+    int[] faceVertexCounts = [4]
+    int[] faceVertexIndices = [0, 3, 2, 1]
+    point3f[] points = [(-3, -1, -3), (3, -1, -3), (3, -1, 3), (-3, -1, 3)]
+    color3f[] primvars:displayColor = [(0.5, 0.5, 0.5)]
+}
+'''
+
+
+def test_light_sampling_of_an_emissive_sphere_keeps_the_mean(tmp_path):
+    """A small emissive sphere (radius 0.1, radiance 50) in fog over a grey floor, behind the camera
+    (every pixel is scattered light), path tracer: with the sphere sampled as a light (next-event
+    estimation, MIS with hits) and with hits only, the same mean (a wrong MIS weight or light
+    density shifts it)."""
+    body = SMALL_SPHERE + emissive_material("glow", 50.0) + sphere_mesh("bulb", 0.1, False, "/World/glow",
+                                                                         center=(0.2, 0.3, 0.6))
+    path = stage_file(tmp_path, "bulb", body)
+    nee = pass_means(path, "pathTracer", True, seeds=(1, 2, 3, 4), passes=32)
+    hits = pass_means(path, "pathTracer", False, seeds=(1, 2, 3, 4), passes=32)
+    assert nee[0] > 0.01, nee
+    assert_agree(nee, hits, "emissive sphere: light sampling vs hits only")
+    # Light sampling is the point: at equal samples its error is well below hit-only's.
+    assert nee[1] < 0.5 * hits[1], (nee, hits)
