@@ -27,14 +27,9 @@ K sigma of 1 plus the photon map's kernel allowance stated there.
 import math
 import textwrap
 
-import numpy as np
 import pytest
 
-from conftest import usda
-
-from pxr import Usd  # noqa: E402
-
-from volphoton import _core, usdscene  # noqa: E402
+import slab_scene
 
 K = 5.0
 RES = 8
@@ -89,45 +84,6 @@ def emissive_material(name, emission, diffuse=0.0):
         ''') % {"n": name, "e": emission, "d": diffuse}
 
 
-CAMERA = '''def Camera "cam"
-{
-    float focalLength = 50
-    float horizontalAperture = 20
-    float verticalAperture = 20
-    float2 clippingRange = (1e-4, 1e6)
-    double3 xformOp:translate = (0, %(y)g, 0)
-    float3 xformOp:rotateXYZ = (%(rx)g, 0, 0)
-    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
-}
-'''
-
-SLAB = '''def Cube "fog" (
-    prepend apiSchemas = ["VolPhotonMediumAPI"]
-)
-{
-    double size = 1
-    float volphoton:ior = 1
-    float volphoton:density = 1
-    color3f volphoton:albedo = (0.8, 0.8, 0.8)
-    double3 xformOp:translate = (0, 0.5, 0)
-    float3 xformOp:scale = (4, 1, 4)
-    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
-}
-def Mesh "ground"
-{
-    int[] faceVertexCounts = [4]
-    int[] faceVertexIndices = [0, 3, 2, 1]
-    point3f[] points = [(-3, -0.02, -3), (3, -0.02, -3), (3, -0.02, 3), (-3, -0.02, 3)]
-    color3f[] primvars:displayColor = [(0, 0, 0)]
-}
-'''
-
-DOME = '''def DomeLight "sky"
-{
-    float inputs:intensity = 1
-}
-'''
-
 # A square at y = 3 facing down (-Y), half-width 8.
 PLANE = '''def Mesh "panel" (
     prepend apiSchemas = ["MaterialBindingAPI"]
@@ -143,37 +99,14 @@ PLANE = '''def Mesh "panel" (
 
 def stage_file(tmp_path, name, body):
     path = tmp_path / (name + ".usda")
-    text = '#usda 1.0\n(\n    upAxis = "Y"\n)\n' + 'def Xform "World"\n{\n' + textwrap.indent(body, "    ") + "}\n"
-    path.write_text(usda(text))
+    path.write_text(slab_scene.stage_text(body))
     return str(path)
 
 
 def pass_means(path, integrator, emissive_mesh_lights=True, seeds=SEEDS, passes=PASSES):
-    """Image mean (RGB average) of every pass over the seeds, at default settings."""
-    stage = Usd.Stage.Open(path)
-    sc = usdscene.translate(stage, Usd.TimeCode.Default(), RES, RES, "/World/cam")
-    assert not sc.errors, "\n".join(map(str, sc.errors))
-    sc.desc.emissive_mesh_lights = emissive_mesh_lights
-    scene = _core.Scene(sc.desc)
-    out = []
-    for seed in seeds:
-        s = _core.RenderSettings()
-        s.width = s.height = RES
-        s.samples_per_pixel = passes
-        s.seed = seed
-        if integrator == "photonMap":
-            s.integrator = _core.RenderSettings.Integrator.PhotonMap
-        r = _core.Renderer(scene, s)
-        prev = 0.0
-        for k in range(1, passes + 1):
-            assert r.render_pass()
-            img = r.film.beauty.astype(np.float64)
-            assert np.isfinite(img).all()
-            cum = float(img.mean()) * k
-            out.append(cum - prev)
-            prev = cum
-    v = np.array(out)
-    return v.mean(), v.std(ddof=1) / math.sqrt(len(v))
+    """(mean, standard error) of the per-pass image means over the seeds, at default settings."""
+    return slab_scene.mean_and_error(slab_scene.pass_means(path, integrator, RES, seeds, passes,
+                                                           emissive_mesh_lights=emissive_mesh_lights))
 
 
 def assert_agree(a, b, what):
@@ -183,16 +116,18 @@ def assert_agree(a, b, what):
     assert abs(ma - mb) <= tol, "%s: %.5f +- %.5f vs %.5f +- %.5f (tolerance %.5f)" % (what, ma, sa, mb, sb, tol)
 
 
-BELOW = CAMERA % {"y": -0.01, "rx": 90}  # just under the slab, looking up
+BELOW = slab_scene.camera("below")  # 1e-3 under the slab, looking up
+GROUND = slab_scene.ground(3)
 
 
 @pytest.fixture(scope="module")
 def slab_renders(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("emissive")
-    dome = stage_file(tmp, "dome", BELOW + SLAB + DOME)
-    enclosure = stage_file(tmp, "enclosure", BELOW + SLAB + emissive_material("glow", 1.0) +
+    slab = BELOW + slab_scene.SLAB + GROUND
+    dome = stage_file(tmp, "dome", slab + slab_scene.DOME)
+    enclosure = stage_file(tmp, "enclosure", slab + emissive_material("glow", 1.0) +
                            sphere_mesh("enclosure", 6.0, True, "/World/glow"))
-    plane = stage_file(tmp, "plane", BELOW + SLAB + emissive_material("glow", 1.0) + PLANE)
+    plane = stage_file(tmp, "plane", slab + emissive_material("glow", 1.0) + PLANE)
     out = {}
     for integrator in INTEGRATORS:
         out["dome", integrator] = pass_means(dome, integrator)
@@ -220,7 +155,9 @@ def test_both_integrators_agree_under_emissive_geometry(slab_renders, scene):
                  "%s: photon map vs path tracer" % scene)
 
 
-FURNACE = CAMERA % {"y": 0, "rx": 0} + '''def Cube "fog" (
+CENTRE = slab_scene.CAMERA.format(cam_y=0, cam_rx=0)  # at the origin, looking down -Z
+
+FURNACE = CENTRE + '''def Cube "fog" (
     prepend apiSchemas = ["VolPhotonMediumAPI"]
 )
 {
@@ -247,7 +184,7 @@ def test_white_furnace_inside_an_emissive_enclosure(tmp_path, integrator):
     assert abs(m - 1.0) <= K * se + allowance, (m, se)
 
 
-SMALL_SPHERE = CAMERA % {"y": 0, "rx": 0} + '''def Cube "fog" (
+SMALL_SPHERE = CENTRE + '''def Cube "fog" (
     prepend apiSchemas = ["VolPhotonMediumAPI"]
 )
 {

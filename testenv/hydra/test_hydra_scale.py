@@ -18,6 +18,7 @@ import subprocess
 import numpy as np
 import pytest
 
+import slab_scene
 from hydra_util import run_usdrecord, volphoton_exe
 
 from volphoton import output  # noqa: E402
@@ -26,73 +27,14 @@ SEEDS = (1, 2, 3)
 K = 5.0
 SIZE = 16
 
-SCENE = """#usda 1.0
-(
-    upAxis = "Y"
-    renderSettingsPrimPath = "/Render/settings"
-)
-
-def Scope "Render"
-{{
-    def RenderSettings "settings"
-    {{
-        int2 resolution = ({size}, {size})
-        rel camera = </World/cam>
-        int volphoton:samplesPerPixel = 16
-        int volphoton:seed = {seed}
-    }}
-}}
-
-def Xform "World"
-{{
-    def Camera "cam"
-    {{
-        float focalLength = 50
-        float horizontalAperture = 20
-        float verticalAperture = 20
-        float2 clippingRange = (1e-5, 1e8)
-        double3 xformOp:translate = (0, {cam_y}, 0)
-        float3 xformOp:rotateXYZ = ({cam_rx}, 0, 0)
-        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
-    }}
-
-    def Cube "fog" (
-        prepend apiSchemas = ["VolPhotonMediumAPI"]
-    )
-    {{
-        double size = 1
-        float volphoton:ior = 1
-        float volphoton:density = 1
-        color3f volphoton:albedo = (0.8, 0.8, 0.8)
-        double3 xformOp:translate = (0, 0.5, 0)
-        float3 xformOp:scale = (4, 1, 4)
-        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
-    }}
-
-    def Mesh "ground"
-    {{
-        int[] faceVertexCounts = [4]
-        int[] faceVertexIndices = [0, 3, 2, 1]
-        point3f[] points = [(-{w}, -0.02, -{w}), ({w}, -0.02, -{w}), ({w}, -0.02, {w}), (-{w}, -0.02, {w})]
-        color3f[] primvars:displayColor = [(0, 0, 0)]
-    }}
-
-    def DomeLight "sky"
-    {{
-        float inputs:intensity = 1
-    }}
-}}
-"""
-
-VIEWS = {"below": dict(cam_y=-1e-3, cam_rx=90), "above": dict(cam_y=1 + 1e-3, cam_rx=-90)}
-
-
 def image_means(tmp_path, hydra_env, view, w, cli=False):
     """Image mean per seed, through usdrecord (or `volphoton render` when cli)."""
     means = []
     for seed in SEEDS:
         stage = tmp_path / ("%s_%g_%d.usda" % (view, w, seed))
-        stage.write_text(SCENE.format(size=SIZE, seed=seed, w=repr(float(w)), **VIEWS[view]))
+        stage.write_text(slab_scene.stage_text(
+            slab_scene.camera(view) + slab_scene.SLAB + slab_scene.ground(w) + slab_scene.DOME,
+            settings=dict(size=SIZE, spp=16, seed=seed)))
         out = tmp_path / ("%s_%g_%d%s.exr" % (view, w, seed, "_cli" if cli else ""))
         if cli:
             r = subprocess.run([volphoton_exe(), "render", str(stage), "-o", str(out), "--no-png", "-q"],
@@ -109,7 +51,7 @@ def image_means(tmp_path, hydra_env, view, w, cli=False):
     return np.array(means)
 
 
-@pytest.mark.parametrize("view", sorted(VIEWS))
+@pytest.mark.parametrize("view", sorted(slab_scene.VIEWS))
 def test_thin_slab_is_the_same_whatever_the_ground_plane_size(tmp_path, hydra_env, view):
     small = image_means(tmp_path, hydra_env, view, 1e2)
     large = image_means(tmp_path, hydra_env, view, 1e6)
