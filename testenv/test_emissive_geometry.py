@@ -13,6 +13,8 @@ Scenes (all at default settings but resolution and passes):
   * slab under an emissive plane: the same slab under a downward-facing emissive square instead of
     the dome; the path tracer and the photon map must agree.  Before emissive meshes were lights,
     the photon map returned only the unscattered part here.
+  * UsdLux MeshLightAPI: the same panel as a mesh light (intensity normalized by its area) renders
+    as the emissiveColor panel.
   * light sampling does not change the answer: a small emissive sphere in fog, rendered with its
     mesh light (next-event estimation + MIS) and with hits only (SceneDesc.emissive_mesh_lights
     False, the old way): equal means.  The equal-time error of the two is measured by
@@ -20,7 +22,7 @@ Scenes (all at default settings but resolution and passes):
 
 Tolerance: the image mean of each (seed, pass) is one sample; sigma is the standard error of the
 mean over the seeds x passes; two renders agree when they differ by less than K = 5 combined sigma
-(7 comparisons: a Gaussian exceeds 5 sigma with probability 6e-7 each), and the furnace is within
+(9 comparisons: a Gaussian exceeds 5 sigma with probability 6e-7 each), and the furnace is within
 K sigma of 1 plus the photon map's kernel allowance stated there.
 """
 
@@ -97,6 +99,13 @@ PLANE = '''def Mesh "panel" (
 '''
 
 
+# The same square as a UsdLux mesh light: intensity 256 normalized by its area (16 x 16) is radiance
+# 1; its material has no glow (materialGlowTintsLight then leaves the light's colour alone).
+MESH_LIGHT_PLANE = PLANE.replace('''prepend apiSchemas = ["MaterialBindingAPI"]''',
+                                 '''prepend apiSchemas = ["MaterialBindingAPI", "MeshLightAPI"]''').replace(
+    "rel material:binding", "float inputs:intensity = 256\n    bool inputs:normalize = 1\n    rel material:binding")
+
+
 def stage_file(tmp_path, name, body):
     path = tmp_path / (name + ".usda")
     path.write_text(slab_scene.stage_text(body))
@@ -128,11 +137,13 @@ def slab_renders(tmp_path_factory):
     enclosure = stage_file(tmp, "enclosure", slab + emissive_material("glow", 1.0) +
                            sphere_mesh("enclosure", 6.0, True, "/World/glow"))
     plane = stage_file(tmp, "plane", slab + emissive_material("glow", 1.0) + PLANE)
+    mesh_light = stage_file(tmp, "mesh_light", slab + emissive_material("glow", 0.0) + MESH_LIGHT_PLANE)
     out = {}
     for integrator in INTEGRATORS:
         out["dome", integrator] = pass_means(dome, integrator)
         out["enclosure", integrator] = pass_means(enclosure, integrator)
         out["plane", integrator] = pass_means(plane, integrator)
+        out["mesh_light", integrator] = pass_means(mesh_light, integrator)
     return out
 
 
@@ -156,6 +167,40 @@ def test_both_integrators_agree_under_emissive_geometry(slab_renders, scene):
 
 
 CENTRE = slab_scene.CAMERA.format(cam_y=0, cam_rx=0)  # at the origin, looking down -Z
+
+@pytest.mark.parametrize("integrator", INTEGRATORS)
+def test_a_mesh_light_is_its_surface_emission(slab_renders, integrator):
+    """UsdLux MeshLightAPI on the panel (intensity 256, normalize, area 256) renders as the panel
+    with emissiveColor 1 (core/translate/light.h, kind "mesh")."""
+    assert_agree(slab_renders["mesh_light", integrator], slab_renders["plane", integrator],
+                 "%s: MeshLightAPI panel vs emissiveColor panel" % integrator)
+
+
+@pytest.mark.parametrize("bad,severity,attribute", [
+    ("float inputs:intensity = nan", "error", "inputs:intensity"),
+    ('float inputs:intensity = 256\n    uniform token light:materialSyncMode = "glow"', "warning",
+     "light:materialSyncMode"),
+])
+def test_a_mesh_light_with_unusable_values_is_named_and_the_render_goes_on(tmp_path, bad, severity, attribute):
+    """inputs:intensity = nan on a MeshLightAPI mesh: an error naming the prim and the attribute, and
+    the mesh stays plain geometry; an unknown materialSyncMode: a warning, the default used.  The
+    render goes on, finite."""
+    from pxr import Usd
+
+    from volphoton import usdscene
+
+    panel = MESH_LIGHT_PLANE.replace("float inputs:intensity = 256", bad)
+    path = stage_file(tmp_path, "bad_mesh_light", BELOW + slab_scene.SLAB + GROUND + emissive_material("glow", 0.0) + panel)
+    sc = usdscene.translate(Usd.Stage.Open(path), Usd.TimeCode.Default(), RES, RES, "/World/cam")
+    named = [d for d in sc.diagnostics if d.prim_path == "/World/panel"]
+    assert any(d.severity == severity and d.attribute == attribute for d in named), sc.diagnostics
+    assert any(m.prim_path == "/World/panel" for m in sc.meshes)  # still geometry
+    m, _ = slab_scene.mean_and_error(slab_scene.pass_means(path, "pathTracer", RES, (1,), 4, allow_errors=True))
+    if severity == "error":
+        assert m < 0.05, m  # no light left in the scene
+    else:
+        assert 0.3 < m < 1, m  # lit by the panel, as with the default mode
+
 
 FURNACE = CENTRE + '''def Cube "fog" (
     prepend apiSchemas = ["VolPhotonMediumAPI"]

@@ -6,6 +6,7 @@
 #include "pxr/imaging/hd/sceneDelegate.h"
 #include "pxr/imaging/hd/tokens.h"
 #include "pxr/usd/sdf/assetPath.h"
+#include "pxr/usd/usdLux/lightAPI.h"
 
 #include "hd/conversions.h"
 #include "hd/mediumParams.h"
@@ -34,6 +35,42 @@ VtValue _LightParam(HdSceneDelegate *sd, SdfPath const &id, char const *name) {
 
 }  // namespace
 
+translate::AttributeRecord HdVolPhoton_ReadLightRecord(HdSceneDelegate *sd, SdfPath const &id, std::string *textureAsset) {
+    // A parameter is present when the prim has the attribute (e.g. the shaping inputs only with
+    // ShapingAPI applied).
+    translate::AttributeRecord record;
+    record.primPath = id.GetString();
+    for (std::string const &name : translate::lightAttributeNames()) {
+        VtValue v = _LightParam(sd, id, name.c_str());
+        if (v.IsEmpty()) continue;
+        if (v.IsHolding<SdfAssetPath>()) {
+            SdfAssetPath const &a = v.UncheckedGet<SdfAssetPath>();
+            if (name == "inputs:texture:file" && textureAsset) *textureAsset = a.GetAssetPath();
+            record.values[name] = a.GetResolvedPath();
+            continue;
+        }
+        record.values[name] = HdVolPhoton_ToAttrValue(v);
+    }
+    return record;
+}
+
+std::optional<translate::AttributeRecord> HdVolPhoton_ReadMeshLightRecord(HdSceneDelegate *sd, SdfPath const &id) {
+    UsdTimeCode time;
+    if (UsdPrim prim = HdVolPhoton_FindUsdPrim(sd, id, &time)) {
+        if (!prim.HasAPI<UsdLuxLightAPI>()) return std::nullopt;
+        translate::AttributeRecord record;
+        record.primPath = id.GetString();
+        for (std::string const &name : translate::lightAttributeNames()) {
+            VtValue v;
+            if (UsdAttribute attr = prim.GetAttribute(TfToken(name)); attr && attr.Get(&v, time) && !v.IsEmpty())
+                record.values[name] = HdVolPhoton_ToAttrValue(v);
+        }
+        return record;
+    }
+    if (_LightParam(sd, id, "inputs:intensity").IsEmpty()) return std::nullopt;
+    return HdVolPhoton_ReadLightRecord(sd, id);
+}
+
 void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdDirtyBits *dirtyBits) {
     SdfPath const &id = GetId();
     auto &registry = static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit();
@@ -50,22 +87,9 @@ void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdD
         return;
     }
     // The UsdLux attributes the translation layer reads (core/translate/light.h has the rules,
-    // shared with the usd-core front end). A parameter is present when the prim has the attribute
-    // (e.g. the shaping inputs only with ShapingAPI applied).
-    translate::AttributeRecord record;
-    record.primPath = id.GetString();
+    // shared with the usd-core front end).
     std::string textureAsset;
-    for (std::string const &name : translate::lightAttributeNames()) {
-        VtValue v = _LightParam(sd, id, name.c_str());
-        if (v.IsEmpty()) continue;
-        if (v.IsHolding<SdfAssetPath>()) {
-            SdfAssetPath const &a = v.UncheckedGet<SdfAssetPath>();
-            if (name == "inputs:texture:file") textureAsset = a.GetAssetPath();
-            record.values[name] = a.GetResolvedPath();
-            continue;
-        }
-        record.values[name] = HdVolPhoton_ToAttrValue(v);
-    }
+    translate::AttributeRecord record = HdVolPhoton_ReadLightRecord(sd, id, &textureAsset);
     translate::LightContext context;
     context.kind = _lightType == HdPrimTypeTokens->distantLight ? "distant"
                  : _lightType == HdPrimTypeTokens->sphereLight ? "sphere"

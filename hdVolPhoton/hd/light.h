@@ -5,7 +5,27 @@
 #include "pxr/pxr.h"
 #include "pxr/imaging/hd/light.h"
 
+#include "core/translate/record.h"
+
+#include <optional>
+#include <string>
+
 PXR_NAMESPACE_OPEN_SCOPE
+
+class HdSceneDelegate;
+
+/// The UsdLux attributes the translation layer reads (translate::lightAttributeNames()) of the light
+/// sprim `id`, through HdSceneDelegate::GetLightParamValue; the dome texture's authored asset path
+/// in *textureAsset.
+volphoton::translate::AttributeRecord HdVolPhoton_ReadLightRecord(HdSceneDelegate *sceneDelegate, SdfPath const &id,
+                                                                   std::string *textureAsset = nullptr);
+
+/// The same attributes of rprim `id` when it is a mesh light (LightAPI, e.g. MeshLightAPI, on a
+/// Gprim), nullopt when it is not: off the UsdPrim on the legacy scene delegate (it answers light
+/// parameters for light prims only), through GetLightParamValue on the scene-index path (where the
+/// LightAPI adapter gives the mesh its light data).
+std::optional<volphoton::translate::AttributeRecord> HdVolPhoton_ReadMeshLightRecord(HdSceneDelegate *sceneDelegate,
+                                                                                    SdfPath const &id);
 
 /// \class HdVolPhotonLight
 ///

@@ -10,6 +10,7 @@
 
 #include "hd/conversions.h"
 #include "hd/instancer.h"
+#include "hd/light.h"
 #include "hd/renderParam.h"
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -116,6 +117,27 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
         for (volphoton::Affine const &a : rec.instances) singular += !a.inverse();
         if (singular) TF_WARN("%s: %zu instance transforms are not invertible or not finite; those are skipped", id.GetText(), singular);
     }
+
+    // A mesh light (MeshLightAPI): its surface emits what the translation layer makes of its UsdLux
+    // attributes (core/translate/light.h, kind "mesh"; inputs:normalize divides by the world area
+    // under the first instance's transform, as the usd-core front end does).
+    if (!rec.hasMedium && !rec.instances.empty())
+        if (auto lightRecord = HdVolPhoton_ReadMeshLightRecord(sceneDelegate, id)) {
+            volphoton::translate::LightContext context;
+            context.kind = "mesh";
+            context.typeName = "Mesh";
+            context.lightToWorld = rec.instances[0];
+            for (size_t t = 0; t + 2 < rec.mesh.indices.size(); t += 3) {
+                volphoton::Vec3 a = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t]]);
+                volphoton::Vec3 b = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t + 1]]);
+                volphoton::Vec3 c = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t + 2]]);
+                context.meshArea += 0.5 * volphoton::length(volphoton::cross(b - a, c - a));
+            }
+            volphoton::translate::Diagnostics diagnostics;
+            volphoton::translate::LightResult light = volphoton::translate::translateLight(*lightRecord, context, diagnostics);
+            HdVolPhoton_Report(diagnostics);
+            if (light.kind == "mesh") rec.meshLight = std::move(light);
+        }
 
     static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit().SetMesh(id, std::move(rec));
     *dirtyBits &= ~HdChangeTracker::AllSceneDirtyBits;

@@ -137,6 +137,7 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera, st
                     mesh.material = *m->second.material;
                 }
             }
+            if (!rec.hasMedium && rec.meshLight) mesh.material = translate::meshLightSurface(*rec.meshLight, mesh.material);
             if (rec.hasMedium) {
                 // The medium lives in the space of the first instance (media are not instanced).
                 translate::Diagnostics diagnostics;

@@ -8,6 +8,7 @@
 
 #include "core/scene.h"
 #include "hd/mediumParams.h"
+#include "core/translate/light.h"
 
 #include <map>
 #include <optional>
@@ -33,6 +34,9 @@ struct HdVolPhoton_MeshRecord {
     HdVolPhoton_MediumSource mediumSource;  ///< set when the medium may vary in time (legacy path)
     SdfPath materialId;  ///< bound material of the faces in no subset
     std::vector<HdVolPhoton_SubsetRecord> subsets;
+    /// A mesh light (MeshLightAPI): applied to its materials when the scene is built
+    /// (translate::meshLightSurface).
+    std::optional<volphoton::translate::LightResult> meshLight;
 };
 
 /// A material as synced: valid when it had a UsdPreviewSurface; material empty = not rendered.

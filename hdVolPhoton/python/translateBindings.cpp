@@ -193,8 +193,9 @@ void bindTranslate(py::module_& m) {
           "UsdLuxBlackbodyTemperatureAsRgb: RGB normalised to luminance 1");
     m.def("translate_light", [](const std::string& prim, const py::dict& values, const std::string& kind,
                                 const std::string& typeName, const Affine& world, bool hasFilters,
-                                const std::string& textureAssetPath) {
+                                const std::string& textureAssetPath, double meshArea) {
         LightContext c;
+        c.meshArea = meshArea;
         c.kind = kind;
         c.typeName = typeName;
         c.lightToWorld = world;
@@ -206,12 +207,20 @@ void bindTranslate(py::module_& m) {
         for (auto& [k, v] : r.scalars) params[py::str(k)] = v;
         for (auto& [k, v] : r.vectors) params[py::str(k)] = v;
         if (r.kind == "dome") params["texture"] = r.texture;
+        if (r.kind == "mesh") params["material_sync_mode"] = r.materialSyncMode;
         if (params.contains("normalize")) params["normalize"] = params["normalize"].cast<double>() != 0;
         py::object light = r.light ? py::cast(mutableCopy(r.light)) : py::none();
         return py::make_tuple(light, r.kind, r.emission, r.quantity, params, toPy(d));
     }, py::arg("prim"), py::arg("values"), py::arg("kind"), py::arg("type_name"), py::arg("light_to_world"),
-       py::arg("has_filters") = false, py::arg("texture_asset_path") = "",
+       py::arg("has_filters") = false, py::arg("texture_asset_path") = "", py::arg("mesh_area") = 0.0,
        "(Light or None, kind, emission, quantity, params, diagnostics): core/translate/light.h");
+    m.def("mesh_light_surface", [](const Spectrum& emission, const std::string& materialSyncMode, const SurfaceMaterial& m) {
+        LightResult light;
+        light.emission = emission;
+        light.materialSyncMode = materialSyncMode;
+        return meshLightSurface(light, m);
+    }, py::arg("emission"), py::arg("material_sync_mode"), py::arg("material"),
+       "The SurfaceMaterial of a mesh with MeshLightAPI (core/translate/light.h meshLightSurface)");
 
     m.def("render_settings_table", [] {
         py::list out;

@@ -451,6 +451,35 @@ def test_emissive_geometry_lights_media_in_both_doors(tmp_path, hydra_env, integ
     assert_doors_agree(hydra, cli, "fog under an emissive panel (%s)" % integrator)
 
 
+# The same panel as a UsdLux mesh light (no material: the light's colour is the emission).
+MESH_LIGHT_PANEL = EMISSIVE_PANEL[:EMISSIVE_PANEL.index('    def Material "glow"')] + '''    def Mesh "panel" (
+        prepend apiSchemas = ["MeshLightAPI"]
+    )
+    {
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(-1, 1.5, -1), (1, 1.5, -1), (1, 1.5, 1), (-1, 1.5, 1)]
+        float inputs:intensity = 8
+        color3f inputs:color = (1, 0.75, 0.5)
+        bool inputs:normalize = 1
+    }
+'''
+
+
+@pytest.mark.parametrize("scene_index", [False, True], ids=["legacy", "sceneIndex"])
+def test_mesh_light_api_lights_media_in_both_doors(tmp_path, hydra_env, scene_index):
+    """MeshLightAPI on the panel (intensity 8 normalized by its area 4, colour (1, 0.75, 0.5):
+    radiance (2, 1.5, 1), as the emissive panel above): both doors make it an emitting surface and a
+    light (core/translate/light.h, kind "mesh"), on the legacy scene delegate (read off the UsdPrim)
+    and on the scene-index path (the LightAPI adapter's light data).  Without it the usd-core front
+    end skipped the mesh as an unsupported light and the delegate rendered it as grey geometry."""
+    hydra, cli, hlog, clog = render_both(hydra_env, tmp_path, "mesh_light", lambda s: stage_text(MESH_LIGHT_PANEL, s),
+                                         scene_index=scene_index)
+    check(cli.mean() > 0.02, "the CLI's fog is not lit by the mesh light: mean %.4f" % cli.mean())
+    check(not warning_lines(clog, "/World/panel", "not supported"), clog[-2000:])
+    assert_doors_agree(hydra, cli, "fog under a MeshLightAPI panel")
+
+
 # --------------------------------------------------------------------------------------------------
 # 4. Exponential haze on a Z-up stage
 # --------------------------------------------------------------------------------------------------

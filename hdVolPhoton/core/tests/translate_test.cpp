@@ -211,6 +211,46 @@ TEST(TranslateLight, ColorTemperatureMultipliesTheColour) {
     for (int i = 0; i < 3; ++i) EXPECT_DOUBLE_EQ(l.emission[i], bb[i]);
 }
 
+TEST(TranslateLight, MeshLightIsTheMeshSurfaceEmission) {
+    AttributeRecord r;
+    r.primPath = "/panel";
+    r.set("inputs:intensity", 8.0);
+    r.set("inputs:color", Vec3(1, 0.5, 0.25));
+    r.set("inputs:normalize", true);
+    LightContext c;
+    c.kind = "mesh";
+    c.meshArea = 4.0;
+    Diagnostics d;
+    LightResult l = translateLight(r, c, d);
+    EXPECT_FALSE(l.light);  // the Scene makes the mesh light from the surface
+    EXPECT_EQ(l.kind, "mesh");
+    EXPECT_EQ(l.emission, Spectrum(2, 1, 0.5));  // s / world area
+    EXPECT_EQ(l.materialSyncMode, "materialGlowTintsLight");  // MeshLightAPI's fallback
+    EXPECT_TRUE(d.list().empty());
+
+    SurfaceMaterial glowing;
+    glowing.albedo = Spectrum(0.3);
+    glowing.emission = Spectrum(0.5, 1, 2);
+    SurfaceMaterial m = meshLightSurface(l, glowing);  // tinted by the material's glow
+    EXPECT_EQ(m.emission, Spectrum(1, 1, 1));
+    EXPECT_EQ(m.albedo, Spectrum(0.3));
+    SurfaceMaterial plain;
+    plain.albedo = Spectrum(0.3);
+    EXPECT_EQ(meshLightSurface(l, plain).emission, l.emission);  // no glow: the light's own
+    l.materialSyncMode = "independent";
+    EXPECT_EQ(meshLightSurface(l, glowing).emission, l.emission);
+    l.materialSyncMode = "noMaterialResponse";
+    EXPECT_EQ(meshLightSurface(l, glowing).albedo, Spectrum(0.0));
+    SurfaceMaterial glass;
+    glass.kind = SurfaceMaterial::Kind::Dielectric;
+    EXPECT_EQ(meshLightSurface(l, glass).kind, SurfaceMaterial::Kind::Lambertian);
+
+    r.set("light:materialSyncMode", std::string("glow"));
+    Diagnostics bad;
+    EXPECT_EQ(translateLight(r, c, bad).materialSyncMode, "materialGlowTintsLight");
+    EXPECT_TRUE(hasDiagnostic(bad, Severity::Warning, "light:materialSyncMode"));
+}
+
 TEST(TranslateSettings, TableDefaultsAndValidation) {
     RenderSettings defaults;
     const SettingInfo* depth = findSetting("maxDepth");

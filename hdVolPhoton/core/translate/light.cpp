@@ -90,7 +90,7 @@ const std::vector<std::string>& lightAttributeNames() {
         "inputs:enableColorTemperature", "inputs:colorTemperature", "inputs:diffuse",  "inputs:specular",
         "inputs:angle",              "inputs:radius",         "treatAsPoint",          "inputs:width",
         "inputs:height",             "inputs:texture:file",   "inputs:texture:format", "inputs:shaping:cone:angle",
-        "inputs:shaping:cone:softness", "inputs:shaping:focus", "inputs:shaping:ies:file"};
+        "inputs:shaping:cone:softness", "inputs:shaping:focus", "inputs:shaping:ies:file", "light:materialSyncMode"};
     return n;
 }
 
@@ -238,6 +238,18 @@ LightResult translateLight(const AttributeRecord& rec, const LightContext& ctx, 
             out.emission = s;
             out.quantity = "radiance";
             out.light = makeDomeLight(s, std::move(image), world);
+        } else if (ctx.kind == "mesh") {
+            std::string sync = r.text("light:materialSyncMode");
+            if (sync.empty()) sync = "materialGlowTintsLight";  // MeshLightAPI's fallback
+            if (sync != "materialGlowTintsLight" && sync != "independent" && sync != "noMaterialResponse") {
+                d.warn(path, "light:materialSyncMode", "'" + sync + "' is not a materialSyncMode; using materialGlowTintsLight");
+                sync = "materialGlowTintsLight";
+            }
+            out.kind = "mesh";
+            out.emission = normalize && ctx.meshArea > 0 ? s / ctx.meshArea : s;
+            out.quantity = "radiance";
+            out.scalars["area"] = ctx.meshArea;
+            out.materialSyncMode = sync;
         } else {
             d.warn(path, "", (ctx.typeName.empty() ? std::string("this kind of") : ctx.typeName) + " lights are not supported; ignored");
         }
@@ -246,6 +258,18 @@ LightResult translateLight(const AttributeRecord& rec, const LightContext& ctx, 
         out.light = nullptr;
     }
     return out;
+}
+
+SurfaceMaterial meshLightSurface(const LightResult& light, SurfaceMaterial m) {
+    if (m.kind != SurfaceMaterial::Kind::Lambertian) {
+        m.kind = SurfaceMaterial::Kind::Lambertian;
+        m.albedo = Spectrum(0.0);
+        m.emission = Spectrum(0.0);
+    }
+    bool tint = light.materialSyncMode == "materialGlowTintsLight" && !m.emission.isBlack();
+    m.emission = tint ? light.emission * m.emission : light.emission;
+    if (light.materialSyncMode == "noMaterialResponse") m.albedo = Spectrum(0.0);
+    return m;
 }
 
 }  // namespace volphoton::translate

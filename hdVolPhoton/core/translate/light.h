@@ -15,6 +15,10 @@
 // | DiskLight (disk)    | inputs:radius                                     | radiance s (/ world area with normalize)     |
 // | DomeLight (dome)    | inputs:texture:file (lat-long OpenEXR, resolved), | radiance s x texture                         |
 // |                     | inputs:texture:format (automatic, latlong)        |                                              |
+// | Mesh + MeshLightAPI | light:materialSyncMode (materialGlowTintsLight,   | no light of its own: the mesh's surface      |
+// | (mesh)              | independent, noMaterialResponse); the mesh's      | emits radiance s (/ world area with          |
+// |                     | world area (context)                              | normalize), see meshLightSurface(); the      |
+// |                     |                                                   | Scene makes it a light (core/lights.h)       |
 // Unusable values: non-finite intensity/exposure/color -> the light is skipped (error); negative
 // intensity or colour channels -> clamped to 0 (warning); inputs:diffuse/specular != 1, shaping focus
 // and IES, rect textures, filters -> ignored (warning); other light types -> not supported (warning).
@@ -26,6 +30,7 @@
 #include <vector>
 
 #include "core/lights.h"
+#include "core/scene.h"
 #include "core/translate/record.h"
 
 namespace volphoton::translate {
@@ -47,6 +52,8 @@ struct LightContext {
     /// inputs:texture:file as authored (the record holds the resolved path, or nothing when it
     /// cannot be resolved).
     std::string textureAssetPath;
+    /// mesh: the world-space area of the mesh's triangles (inputs:normalize divides by it).
+    double meshArea = 0;
 };
 
 /// A translated light and what a front end reports about it.
@@ -58,8 +65,20 @@ struct LightResult {
     std::map<std::string, double> scalars;  ///< half_angle, radius, authored_radius, area, width, ...
     std::map<std::string, Vec3> vectors;    ///< position, direction, axis, normal
     std::string texture;     ///< the dome texture actually used ("" = constant)
+    std::string materialSyncMode;  ///< mesh: light:materialSyncMode as used
 };
 
 LightResult translateLight(const AttributeRecord& record, const LightContext& context, Diagnostics& diagnostics);
+
+/// The surface of a mesh with MeshLightAPI (`light` from translateLight with kind "mesh"), given the
+/// surface its bound material makes (UsdLux materialSyncMode):
+/// | materialSyncMode                 | emission                                    | reflection        |
+/// |----------------------------------|---------------------------------------------|-------------------|
+/// | materialGlowTintsLight (default) | light x the material's emissiveColor, or    | the material's    |
+/// |                                  | the light's alone when that is black        |                   |
+/// | independent                      | the light's (the material's glow ignored)   | the material's    |
+/// | noMaterialResponse               | the light's                                 | none (albedo 0)   |
+/// Emission is lambertian: a dielectric or boundary material becomes a black lambertian emitter.
+SurfaceMaterial meshLightSurface(const LightResult& light, SurfaceMaterial material);
 
 }  // namespace volphoton::translate

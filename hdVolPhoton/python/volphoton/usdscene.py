@@ -657,11 +657,11 @@ class _Translator:
             if prim.IsA(UsdVol.Volume):
                 self.volume(prim)
                 continue
+            if prim.IsA(UsdGeom.Gprim):  # with MeshLightAPI (LightAPI) too: an emissive surface
+                self.gprim(prim)
+                continue
             if prim.HasAPI(UsdLux.LightAPI) or prim.IsA(UsdLux.BoundableLightBase) or prim.IsA(UsdLux.NonboundableLightBase):
                 self.light(prim)
-                continue
-            if prim.IsA(UsdGeom.Gprim):
-                self.gprim(prim)
 
     # -- gprims ------------------------------------------------------------------------------------
     def gprim(self, prim: Usd.Prim, instance_xforms: Optional[List[np.ndarray]] = None,
@@ -691,10 +691,13 @@ class _Translator:
             data = self._gprim_data(prim)
             if data is None:
                 return
+            mesh_light = self._mesh_light(prim, data, xforms[0]) if prim.HasAPI(UsdLux.LightAPI) else None
             records = []
             for label, material, face_mask in groups:
                 if material is None:
                     continue  # transparent / cutout: nothing to render
+                if mesh_light is not None:
+                    material = _core.mesh_light_surface(mesh_light[0], mesh_light[1], material)
                 tri_mask = np.ones(len(data.tris), bool) if face_mask is None else face_mask(data)
                 if not np.any(tri_mask):
                     continue
@@ -717,6 +720,22 @@ class _Translator:
             for x in xforms:
                 rec.instance_indices.append(self.desc.add_instance(rec.mesh_index, x))
                 self.extend_bounds(rec._points @ x[:3, :3].T + x[:3, 3])
+
+    def _mesh_light(self, prim: Usd.Prim, data: _MeshData, world: np.ndarray):
+        """(radiance, materialSyncMode) of a Gprim with MeshLightAPI (the translation layer's rules,
+        core/translate/light.h), or None when its light attributes are unusable (reported). The
+        area for inputs:normalize is the world area under the first transform."""
+        values, _ = vschema.read_attributes(prim, self.time, prefix="", names=_LIGHT_ATTRIBUTES)
+        p = data.points @ world[:3, :3].T
+        t = data.tris
+        area = 0.5 * float(np.linalg.norm(np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]), axis=1).sum())
+        has_filters = bool(UsdLux.LightAPI(prim).GetFiltersRel().GetForwardedTargets())
+        _, kind, emission, _, params, diags = _core.translate_light(
+            str(prim.GetPath()), values, "mesh", str(prim.GetTypeName()), world, has_filters, "", area)
+        self.diags.extend(vschema.diagnostics_from_core(diags))
+        if kind != "mesh":
+            return None
+        return emission, params["material_sync_mode"]
 
     def _gprim_data(self, prim: Usd.Prim) -> Optional[_MeshData]:
         if prim.IsA(UsdGeom.Mesh):
