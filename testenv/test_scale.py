@@ -13,15 +13,19 @@ slab), and the ray leaving its bottom skip the ground 0.02 below (the sky came t
 views changed by far more than the noise.
 
 Through the standalone front end: the .usda files are translated by volphoton.usdscene (as
-`volphoton render` does) and rendered by the core, one image per pass.  The photon map runs its
-single-scattering march and camera paths only (multipleScattering off, march step and radius set):
-its dome photons are emitted over the scene's bounding disk, so with W = 1e6 almost none of them
-reach a 4-unit slab, a separate matter from ray offsets (the multiple part would be pure noise).
+`volphoton render` does) and rendered by the core, one image per pass, at default settings, the
+photon map's multiple scattering included.  Its defaults follow the media, not the scene (kernel
+radius and march step from the media's diameter; half of the dome's photons aimed at the media,
+starting where their line enters the scene's box: core/lights.h PhotonAim).  Before that, with
+W = 1e6 the dome's photons were spread over the scene's disk (almost none reached the slab), and
+those that did started 1.4e6 units away, where single-precision intersection cannot tell the ground
+from the slab 0.02 above it: the multiple-scattering image was 24% too bright (0.108 against 0.087
+over 6 seeds of 16 passes, 3 sigma).
 
 Tolerance: the image mean of each (W, seed, pass) is one sample; sigma is the standard error of
 the mean over 2 seeds x 16 passes.  The difference to W = 1e2 must stay within 5 sigma of the
-combined standard errors (k = 5: 3 W values x 2 views x 2 integrators = 12 comparisons, a Gaussian
-exceeds 5 sigma with probability 6e-7 each).  The old code misses by tens to hundreds of sigma.
+combined standard errors (and, paired, the differences at 1e5 and 1e6 to 1e4: see the test) (k = 5: 3 W values x 2 views x 2 integrators = 12 comparisons, a Gaussian
+exceeds 5 sigma with probability 6e-7 each).  The old offsets miss by tens to hundreds of sigma.
 """
 
 import pytest
@@ -36,28 +40,19 @@ RES = 8
 K = 5.0
 
 
-def single_scattering_march(s):
-    """The photon map without its photon pass, its march step and radius set (see the docstring)."""
-    if s.integrator == s.Integrator.PhotonMap:
-        s.multiple_scattering = False
-        s.march_step = 0.01
-        s.initial_radius = 0.05
-
-
 def pass_means(tmp_path, view, w, integrator):
     """Image mean of every pass, over SEEDS: (len(SEEDS) * PASSES,) float64."""
     path = tmp_path / ("%s_%g.usda" % (view, w))
     path.write_text(slab_scene.stage_text(slab_scene.camera(view) + slab_scene.SLAB + slab_scene.ground(w) +
                                           slab_scene.DOME))
-    return slab_scene.pass_means(path, integrator, RES, SEEDS, PASSES, configure=single_scattering_march)
+    return slab_scene.pass_means(path, integrator, RES, SEEDS, PASSES)
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
 @pytest.mark.parametrize("view", sorted(slab_scene.VIEWS))
 def test_thin_slab_is_the_same_whatever_the_ground_plane_size(tmp_path, view, integrator):
-    stats = {}
-    for w in HALF_WIDTHS:
-        stats[w] = slab_scene.mean_and_error(pass_means(tmp_path, view, w, integrator))
+    values = {w: pass_means(tmp_path, view, w, integrator) for w in HALF_WIDTHS}
+    stats = {w: slab_scene.mean_and_error(v) for w, v in values.items()}
     ref, ref_se = stats[HALF_WIDTHS[0]]
     # The layer is there at all (not black, not the bare sky): 1 unit of optical depth, albedo 0.8.
     if view == "below":
@@ -69,3 +64,13 @@ def test_thin_slab_is_the_same_whatever_the_ground_plane_size(tmp_path, view, in
         tol = K * (se ** 2 + ref_se ** 2) ** 0.5
         print("%s %s W=%g: %.5f +- %.5f (W=1e2: %.5f +- %.5f)" % (integrator, view, w, m, se, ref, ref_se))
         assert abs(m - ref) <= tol, (integrator, view, w, m, se, ref, ref_se)
+    # Paired: the same seeds and passes at W = 1e5 and 1e6 against 1e4, where the ground hides the
+    # same directions to within 1e-4 radians, so the noise cancels and a shift of a fraction of a
+    # sigma above shows (the photon map's photons from 1.4e6 units away made the W = 1e6 view from
+    # below 0.029 brighter, under 3 of the unpaired sigma above). Allowance 1e-4 of the mean for the
+    # horizon the ground still moves.
+    for w in HALF_WIDTHS[2:]:
+        diff = values[w] - values[1e4]
+        m, se = slab_scene.mean_and_error(diff)
+        print("%s %s W=%g - W=1e4 (paired): %.6f +- %.6f" % (integrator, view, w, m, se))
+        assert abs(m) <= K * se + 1e-4 * stats[1e4][0], (integrator, view, w, m, se)

@@ -20,14 +20,15 @@
 // | threads             | int    | 0          |              | 0: all cores                                      |
 // | photonsPerPass      | int    | 100000     |              | photonMap: photons traced per pass               |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
-// |                     |        |            |              | the scene diameter)                               |
+// |                     |        |            |              | the media's diameter, Scene::mediaRadius, else of |
+// |                     |        |            |              | the scene's)                                      |
 // | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
 // | photonRadiusMfp     | double | 8          | mean free    | photonMap: a photon's radius is at most this many |
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
 // |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
-// |                     |        |            |              | the scene diameter)                               |
+// |                     |        |            |              | the media's diameter, else of the scene's)        |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |
 // | multipleScattering  | bool   | true       |              | photonMap: run the photon (multiple) pass         |
 // | multipleThreshold   | double | 1e-3       |              | photonMap: skip photons when a pilot estimates the|

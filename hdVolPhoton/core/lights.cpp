@@ -28,12 +28,38 @@ void requireFinite(const Spectrum& s, const char* what) {
     if (!s.isFinite() || s.minValue() < 0) throw std::invalid_argument(std::string(what) + ": emission must be finite and >= 0");
 }
 
-/// Photon origin on a disc of radius r perpendicular to `dir`, upstream of the scene's bounding sphere.
-Vec3 upstreamDiscPoint(const Vec3& center, double radius, const Vec3& dir, double u1, double u2) {
-    double x, y;
-    concentricDisk(u1, u2, &x, &y);
+/// A photon origin upstream of aim's disks for direction `dir` (PhotonAim), and the density of that
+/// origin over the plane perpendicular to dir (per unit area).
+std::pair<Vec3, double> upstreamPoint(const PhotonAim& aim, const Vec3& dir, double u1, double u2) {
     Frame f = Frame::fromZ(dir);
-    return center - dir * radius + f.s * (x * radius) + f.t * (y * radius);
+    // Disk centres in the plane's coordinates, relative to the scene's.
+    double fx = dot(aim.focusCenter - aim.center, f.s), fy = dot(aim.focusCenter - aim.center, f.t);
+    bool focus = aim.focusRadius > 0;
+    double cx = 0, cy = 0, r = aim.radius;
+    if (focus && u1 < 0.5) {
+        u1 *= 2;
+        cx = fx, cy = fy, r = aim.focusRadius;
+    } else if (focus) {
+        u1 = 2 * u1 - 1;
+    }
+    double x, y;
+    concentricDisk(std::min(u1, std::nextafter(1.0, 0.0)), u2, &x, &y);
+    x = cx + x * r, y = cy + y * r;
+    double pdf = 1 / (Pi * aim.radius * aim.radius) * (x * x + y * y <= aim.radius * aim.radius ? 1.0 : 0.0);
+    if (focus) {
+        double dx = x - fx, dy = y - fy;
+        pdf = 0.5 * pdf + 0.5 / (Pi * aim.focusRadius * aim.focusRadius) *
+                              (dx * dx + dy * dy <= aim.focusRadius * aim.focusRadius ? 1.0 : 0.0);
+    }
+    Vec3 o = aim.center - dir * aim.radius + f.s * x + f.t * y;
+    double t0, t1;
+    if (!aim.box.empty() && aim.box.intersect({o, dir}, 0.0, Infinity, &t0, &t1)) {
+        // Back from the box's face by 1e-4 of its diagonal (and by far more than the float error of
+        // the entry point), so that a surface lying in that face is still met in front of the photon.
+        double margin = std::max(1e-4 * length(aim.box.hi - aim.box.lo), 64 * Scene::floatError(o + dir * t0));
+        o = o + dir * std::max(0.0, t0 - margin);
+    }
+    return {o, pdf};
 }
 
 class DistantLight final : public Light {
@@ -71,9 +97,10 @@ public:
     }
     bool isDelta() const override { return delta_; }
     Spectrum power(double r) const override { return E_ * (Pi * r * r); }
-    PhotonEmission emitPhoton(const Vec3& c, double r, double u[4]) const override {
+    PhotonEmission emitPhoton(const PhotonAim& aim, double u[4]) const override {
         Vec3 d = delta_ ? dir_ : Frame::fromZ(dir_).toWorld(uniformCone(u[2], u[3], cosMax_));
-        return {{upstreamDiscPoint(c, r, d, u[0], u[1]), d}, E_ * (Pi * r * r)};
+        auto [o, pdf] = upstreamPoint(aim, d, u[0], u[1]);
+        return {{o, d}, pdf > 0 ? E_ / pdf : Spectrum(0.0)};
     }
     std::string describe() const override { return "distant"; }
 
@@ -147,7 +174,7 @@ public:
         double share = shaped_ ? (1 - std::cos(cone_)) / 2 : 1.0;
         return (r_ == 0 ? L_ * (4 * Pi) : L_ * (Pi * 4 * Pi * r_ * r_)) * share;
     }
-    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+    PhotonEmission emitPhoton(const PhotonAim&, double u[4]) const override {
         PhotonEmission e;
         if (r_ == 0) {
             Vec3 d = uniformSphere(u[0], u[1]);
@@ -228,7 +255,7 @@ public:
     }
     bool isDelta() const override { return false; }
     Spectrum power(double) const override { return L_ * (Pi * area_); }
-    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+    PhotonEmission emitPhoton(const PhotonAim&, double u[4]) const override {
         Vec3 d = Frame::fromZ(n_).toWorld(cosineHemisphere(u[2], u[3]));
         return {{pointAt(u[0], u[1]) + n_ * 1e-9 * (1 + length(center_)), d}, L_ * (Pi * area_)};
     }
@@ -296,7 +323,7 @@ public:
     }
     bool isDelta() const override { return false; }
     Spectrum power(double) const override { return L_ * (Pi * area_); }
-    PhotonEmission emitPhoton(const Vec3&, double, double u[4]) const override {
+    PhotonEmission emitPhoton(const PhotonAim&, double u[4]) const override {
         auto [p, n] = pointAt(u[0], u[1]);
         Vec3 d = Frame::fromZ(n).toWorld(cosineHemisphere(u[2], u[3]));
         // Off the surface by its float precision, so that the photon's first ray does not meet it.
@@ -394,13 +421,14 @@ public:
     bool isDelta() const override { return false; }
     bool isDome() const override { return true; }
     Spectrum power(double r) const override { return L_ * integral_ * (Pi * r * r); }
-    PhotonEmission emitPhoton(const Vec3& c, double r, double u[4]) const override {
+    PhotonEmission emitPhoton(const PhotonAim& aim, double u[4]) const override {
         double pdf;
         Vec3 toLight = sampleDirection(u[2], u[3], &pdf);
         double pdfDummy;
         Spectrum L = radiance(toLight, &pdfDummy);
         Vec3 d = -toLight;
-        return {{upstreamDiscPoint(c, r, d, u[0], u[1]), d}, pdf > 0 ? L * (Pi * r * r / pdf) : Spectrum(0.0)};
+        auto [o, areaPdf] = upstreamPoint(aim, d, u[0], u[1]);
+        return {{o, d}, pdf > 0 && areaPdf > 0 ? L / (pdf * areaPdf) : Spectrum(0.0)};
     }
     std::string describe() const override { return img_.width ? "dome(texture)" : "dome"; }
 

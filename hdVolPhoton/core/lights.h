@@ -42,6 +42,24 @@ struct PhotonEmission {
     Spectrum flux;
 };
 
+/// Where photons from distant and dome lights (which have no position) enter the scene. Each photon
+/// of direction d starts on a plane upstream of the scene's bounding sphere (center, radius), at a
+/// point of the disk that sphere projects to; with focusRadius > 0 half of the photons take a point
+/// of the disk the media's bounding sphere (focusCenter, focusRadius) projects to instead. The flux
+/// is divided by the mixture's density over that plane, so the estimate is unbiased either way, and
+/// a small medium in a large scene (a fog layer over kilometres of terrain) still gets half of the
+/// photons (the volume photon map stores photons in media only). With a non-empty `box` (the scene's
+/// bounds, where nothing lies outside it) the photon then starts just before its line enters the box,
+/// not on the far plane: a photon from a million units away cannot tell apart surfaces 0.02 apart
+/// (single-precision intersection), one from the box's edge can. Other lights ignore it.
+struct PhotonAim {
+    Vec3 center;
+    double radius = 1;
+    Vec3 focusCenter;
+    double focusRadius = 0;  ///< 0: no focus
+    Bounds3 box;             ///< empty: photons start on the upstream plane
+};
+
 /// \class Light
 /// Immutable; all methods thread-safe.
 class Light {
@@ -61,7 +79,7 @@ public:
     virtual std::optional<Vec3> equiangularCenter() const { return std::nullopt; }
     /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
     virtual Spectrum power(double sceneRadius) const = 0;
-    virtual PhotonEmission emitPhoton(const Vec3& sceneCenter, double sceneRadius, double u[4]) const = 0;
+    virtual PhotonEmission emitPhoton(const PhotonAim& aim, double u[4]) const = 0;
     /// Lights that are scene geometry (mesh lights): the solid-angle density with which sample(ref)
     /// produces the point p on the light, whose geometric normal is n (for MIS at surface hits).
     /// 0 for every other light (their hits come from intersect()).

@@ -42,9 +42,15 @@ constexpr int PhotonBatch = 4096;
 class PhotonMapper final : public Integrator {
 public:
     PhotonMapper(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
-        double diameter = 2 * scene.radius();
+        // Defaults follow the media, not the scene: a fog layer over kilometres of terrain keeps its
+        // own kernel and step (the scene's size when a medium is unbounded). Photons from distant
+        // and dome lights aim half at the media (PhotonAim).
+        double diameter = 2 * (scene.mediaRadius() > 0 ? scene.mediaRadius() : scene.radius());
         radius_ = settings.initialRadius > 0 ? settings.initialRadius : diameter / 100;
         step_ = settings.marchStep > 0 ? settings.marchStep : diameter / 256;
+        aim_ = {scene.center(), scene.radius(), scene.mediaCenter(), scene.mediaRadius(), Bounds3()};
+        // Nothing lies outside the scene's box unless a medium is unbounded.
+        if (scene.mediaRadius() > 0) aim_.box = scene.bounds();
         std::vector<double> extended, point;
         for (const LightPtr& l : scene.lights()) {
             bool isPoint = l->pointPosition().has_value();
@@ -438,7 +444,7 @@ private:
         Spectrum flux;
         int events = 0;  // scatterings, diffuse bounces and dielectric interactions so far
         if (source < scene_.lights().size()) {
-            PhotonEmission e = scene_.lights()[source]->emitPhoton(scene_.center(), scene_.radius(), u);
+            PhotonEmission e = scene_.lights()[source]->emitPhoton(aim_, u);
             ray = e.ray;
             flux = e.flux / (pick * count);
         } else {
@@ -634,6 +640,7 @@ private:
     }
 
     double radius_, step_;
+    PhotonAim aim_;  ///< where distant and dome light photons enter the scene
     bool warnedNarrow_ = false;
     mutable std::atomic<bool> warnedBudget_{false};
     std::vector<int> pointLights_;

@@ -177,6 +177,21 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     }
     center_ = (bounds.lo + bounds.hi) * 0.5;
     radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
+    bounds_ = bounds;
+    // Where the media are: bounded volumes and media inside meshes; none when a medium is unbounded.
+    Bounds3 media;
+    bool unbounded = false;
+    for (int i : desc_.unboundedMedia) {
+        Bounds3 b = desc_.media[i]->bounds();
+        if (isFinite(b.lo) && isFinite(b.hi)) media.extend(b);
+        else unbounded = true;
+    }
+    for (size_t mi = 0; mi < desc_.meshes.size(); ++mi)
+        if (desc_.meshes[mi].interiorMedium >= 0 && !meshBounds_[mi].empty()) media.extend(meshBounds_[mi]);
+    if (!unbounded && !media.empty()) {
+        mediaCenter_ = (media.lo + media.hi) * 0.5;
+        mediaRadius_ = std::max(1e-300, length(media.hi - media.lo) * 0.5);
+    }
 }
 
 Scene::~Scene() {

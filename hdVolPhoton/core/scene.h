@@ -148,6 +148,12 @@ public:
     /// Bounding sphere of geometry and bounded media (for distant and dome light photons).
     Vec3 center() const { return center_; }
     double radius() const { return radius_; }
+    /// The box of geometry and bounded media that center() and radius() bound.
+    const Bounds3& bounds() const { return bounds_; }
+    /// Bounding sphere of the media (volumes with bounds and media inside meshes); radius 0 when
+    /// there are none or one is unbounded. The photon map aims photons and sizes its defaults by it.
+    Vec3 mediaCenter() const { return mediaCenter_; }
+    double mediaRadius() const { return mediaRadius_; }
     /// Bound on the single-precision rounding error of a point p: FloatError x max_i |p_i|.
     /// Offsets that have no surface to go by (shadow-ray ends, mesh bounds) use it.
     static double floatError(const Vec3& p) {
@@ -179,6 +185,9 @@ private:
     bool hasMedia_ = false, emissiveMedia_ = false;
     Vec3 center_;
     double radius_ = 1;
+    Bounds3 bounds_;
+    Vec3 mediaCenter_;
+    double mediaRadius_ = 0;
     std::vector<char> meshClosed_;
     std::vector<int> instanceLight_;  ///< per instance: index of its mesh light in lights(), or -1
 

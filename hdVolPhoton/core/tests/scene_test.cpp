@@ -2,6 +2,8 @@
 // conservation, instancing, nested media, the camera inside a closed medium.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include "core/diagnostics.h"
 #include "core/homogeneousMedium.h"
 #include "core/mediumAggregate.h"
@@ -92,7 +94,7 @@ TEST(SceneLights, PhotonEmissionCarriesThePower) {
         const int n = 100000;
         for (int i = 0; i < n; ++i) {
             double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
-            sum += light->emitPhoton(Vec3(), 10, u).flux[0] / n;
+            sum += light->emitPhoton(PhotonAim{Vec3(), 10}, u).flux[0] / n;
         }
         EXPECT_NEAR(sum / light->power(10)[0], 1.0, 1e-6) << light->describe();
     }
@@ -162,7 +164,7 @@ TEST(SceneLights, EmissiveMeshInstancesAreLightsSampledLikeTheirHits) {
         double flux = 0;
         for (int i = 0; i < 20000; ++i) {
             double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
-            PhotonEmission e = light.emitPhoton(Vec3(), 10, u);
+            PhotonEmission e = light.emitPhoton(PhotonAim{Vec3(), 10}, u);
             flux += e.flux[0] / 20000;
             EXPECT_LT(e.ray.d.y * (inst == 0 ? 1 : -1), 0);
             SurfaceHit self;
@@ -175,6 +177,38 @@ TEST(SceneLights, EmissiveMeshInstancesAreLightsSampledLikeTheirHits) {
     Scene hitsOnly(d);
     EXPECT_EQ(hitsOnly.lights().size(), 1u);
     EXPECT_EQ(hitsOnly.instanceLight(0), -1);
+}
+
+TEST(SceneLights, FocusedDistantAndDomePhotonsCarryTheIrradiance) {
+    // Photons of a distant light (irradiance E along -Y) and of a constant dome aimed at a scene of
+    // radius 10 with a focus sphere of radius 0.5 off centre: the flux through a small square
+    // target, inside the focus or outside it, is E x its area (the distant light) or pi L x its area
+    // (the dome, for a horizontal target seen from above), within 4 standard errors.
+    PhotonAim aim{Vec3(0, 0, 0), 10.0, Vec3(3, 0, 1), 0.5};
+    struct Target { Vec3 c; double half; };
+    for (Target target : {Target{Vec3(3, 0, 1), 0.2}, Target{Vec3(-6, 0, 2), 0.5}}) {
+        double area = 4 * target.half * target.half;
+        for (auto [name, light, expected] :
+             {std::tuple<const char*, LightPtr, double>{"distant", makeDistantLight(Vec3(0, -1, 0), 0.0, Spectrum(2.0)), 2.0 * area},
+              std::tuple<const char*, LightPtr, double>{"dome", makeDomeLight(Spectrum(1.5)), Pi * 1.5 * area}}) {
+            Rng rng(7);
+            const int n = 400000;
+            double sum = 0, sum2 = 0;
+            for (int i = 0; i < n; ++i) {
+                double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+                PhotonEmission e = light->emitPhoton(aim, u);
+                if (!(e.ray.d.y < 0)) continue;  // only downward photons cross the target from above
+                double t = (target.c.y - e.ray.o.y) / e.ray.d.y;
+                Vec3 p = e.ray.at(t);
+                double f = std::abs(p.x - target.c.x) <= target.half && std::abs(p.z - target.c.z) <= target.half ? e.flux[0] : 0.0;
+                sum += f / n;
+                sum2 += f * f / n;
+            }
+            double se = std::sqrt((sum2 - sum * sum) / n);
+            EXPECT_NEAR(sum, expected, 4 * se + 1e-12) << name << " at " << target.c.x;
+            EXPECT_LT(se, 0.1 * expected) << name << " at " << target.c.x;
+        }
+    }
 }
 
 TEST(SceneLights, SpotFalloff) {

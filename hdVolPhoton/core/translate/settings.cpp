@@ -66,7 +66,7 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(intSetting("photonsPerPass", 0, Big, "--photons", "volphoton:photonsPerPass", "Photons per pass", "",
                            "photonMap: photons traced per pass", &RS::photonsPerPass));
     t.push_back(doubleSetting("initialRadius", 0, Big, "", "Initial photon radius (0: auto)", "scene units",
-                              "photonMap: beam radius of pass 0 (0: 1/100 of the scene diameter)", &RS::initialRadius));
+                              "photonMap: beam radius of pass 0 (0: 1/100 of the media's diameter)", &RS::initialRadius));
     t.push_back(doubleSetting("radiusAlpha", 1e-6, 1, "", "Photon radius reduction (alpha)", "",
                               "photonMap: r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1)", &RS::radiusAlpha));
     t.push_back(doubleSetting("photonRadiusMfp", 0, Big, "", "Photon radius cap (mean free paths)", "mean free paths",
@@ -76,7 +76,7 @@ std::vector<SettingInfo> makeTable() {
                            "", "draws per camera sample taken from scrambled Sobol' points (0: independent)",
                            &RS::stratifiedDims));
     t.push_back(doubleSetting("marchStep", 0, Big, "", "March step (0: auto)", "scene units",
-                              "photonMap: single-scattering step (0: 1/256 of the scene diameter)", &RS::marchStep));
+                              "photonMap: single-scattering step (0: 1/256 of the media's diameter)", &RS::marchStep));
     t.push_back(boolSetting("singleScattering", "", "Single scattering pass", "photonMap: run the single-scattering pass",
                             &RS::singleScattering));
     t.push_back(boolSetting("multipleScattering", "", "Multiple scattering pass", "photonMap: run the photon (multiple) pass",
