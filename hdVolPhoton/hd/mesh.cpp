@@ -127,12 +127,9 @@ void HdVolPhotonMesh::Sync(HdSceneDelegate *sceneDelegate, HdRenderParam *render
             context.kind = "mesh";
             context.typeName = "Mesh";
             context.lightToWorld = rec.instances[0];
-            for (size_t t = 0; t + 2 < rec.mesh.indices.size(); t += 3) {
-                volphoton::Vec3 a = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t]]);
-                volphoton::Vec3 b = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t + 1]]);
-                volphoton::Vec3 c = rec.instances[0].point(rec.mesh.points[rec.mesh.indices[t + 2]]);
-                context.meshArea += 0.5 * volphoton::length(volphoton::cross(b - a, c - a));
-            }
+            context.meshArea = volphoton::translate::meshWorldArea(rec.mesh.points, rec.mesh.indices, rec.instances[0]);
+            for (HdVolPhoton_SubsetRecord const &subset : rec.subsets)
+                context.meshArea += volphoton::translate::meshWorldArea(rec.mesh.points, subset.indices, rec.instances[0]);
             volphoton::translate::Diagnostics diagnostics;
             volphoton::translate::LightResult light = volphoton::translate::translateLight(*lightRecord, context, diagnostics);
             HdVolPhoton_Report(diagnostics);

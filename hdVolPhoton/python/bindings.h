@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "converters.h"
@@ -40,6 +41,20 @@ inline pybind11::array_t<float> imageArray(const std::vector<float>& data, int w
     pybind11::array_t<float> a(shape);
     std::copy(data.begin(), data.end(), a.mutable_data());
     return a;
+}
+
+/// An (N, 3) array of numbers (or None: empty) as points; errors name `what`.
+inline std::vector<Vec3> arrayToVec3s(const pybind11::object& o, const char* what) {
+    namespace py = pybind11;
+    if (o.is_none()) return {};
+    auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(o);
+    if (!a) throw py::type_error(std::string(what) + ": expected an (N, 3) array of numbers");
+    if (a.size() == 0) return {};
+    if (a.ndim() != 2 || a.shape(1) != 3) throw py::value_error(std::string(what) + ": expected shape (N, 3)");
+    auto r = a.unchecked<2>();
+    std::vector<Vec3> v(static_cast<size_t>(a.shape(0)));
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) v[i] = Vec3(r(i, 0), r(i, 1), r(i, 2));
+    return v;
 }
 
 }  // namespace volphoton::bindings

@@ -214,6 +214,10 @@ void bindTranslate(py::module_& m) {
     }, py::arg("prim"), py::arg("values"), py::arg("kind"), py::arg("type_name"), py::arg("light_to_world"),
        py::arg("has_filters") = false, py::arg("texture_asset_path") = "", py::arg("mesh_area") = 0.0,
        "(Light or None, kind, emission, quantity, params, diagnostics): core/translate/light.h");
+    m.def("mesh_world_area", [](const py::object& points, const std::vector<uint32_t>& indices, const Affine& world) {
+        return meshWorldArea(bindings::arrayToVec3s(points, "points"), indices, world);
+    }, py::arg("points"), py::arg("indices"), py::arg("to_world"),
+          "World-space area of triangles (core/translate/light.h meshWorldArea)");
     m.def("mesh_light_surface", [](const Spectrum& emission, const std::string& materialSyncMode, const SurfaceMaterial& m) {
         LightResult light;
         light.emission = emission;

@@ -260,6 +260,16 @@ LightResult translateLight(const AttributeRecord& rec, const LightContext& ctx, 
     return out;
 }
 
+double meshWorldArea(const std::vector<Vec3>& points, const std::vector<uint32_t>& indices, const Affine& toWorld) {
+    double area = 0;
+    for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+        Vec3 a = toWorld.point(points[indices[t]]), b = toWorld.point(points[indices[t + 1]]),
+             c = toWorld.point(points[indices[t + 2]]);
+        area += 0.5 * length(cross(b - a, c - a));
+    }
+    return area;
+}
+
 SurfaceMaterial meshLightSurface(const LightResult& light, SurfaceMaterial m) {
     if (m.kind != SurfaceMaterial::Kind::Lambertian) {
         m.kind = SurfaceMaterial::Kind::Lambertian;

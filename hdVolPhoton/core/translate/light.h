@@ -70,6 +70,9 @@ struct LightResult {
 
 LightResult translateLight(const AttributeRecord& record, const LightContext& context, Diagnostics& diagnostics);
 
+/// The world-space area of triangles (indices in threes) under toWorld: LightContext::meshArea.
+double meshWorldArea(const std::vector<Vec3>& points, const std::vector<uint32_t>& indices, const Affine& toWorld);
+
 /// The surface of a mesh with MeshLightAPI (`light` from translateLight with kind "mesh"), given the
 /// surface its bound material makes (UsdLux materialSyncMode):
 /// | materialSyncMode                 | emission                                    | reflection        |

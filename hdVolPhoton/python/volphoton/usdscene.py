@@ -726,9 +726,7 @@ class _Translator:
         core/translate/light.h), or None when its light attributes are unusable (reported). The
         area for inputs:normalize is the world area under the first transform."""
         values, _ = vschema.read_attributes(prim, self.time, prefix="", names=_LIGHT_ATTRIBUTES)
-        p = data.points @ world[:3, :3].T
-        t = data.tris
-        area = 0.5 * float(np.linalg.norm(np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]), axis=1).sum())
+        area = _core.mesh_world_area(data.points, data.tris.reshape(-1), world)
         has_filters = bool(UsdLux.LightAPI(prim).GetFiltersRel().GetForwardedTargets())
         _, kind, emission, _, params, diags = _core.translate_light(
             str(prim.GetPath()), values, "mesh", str(prim.GetTypeName()), world, has_filters, "", area)
