@@ -3,6 +3,7 @@
 import os
 import shutil
 import subprocess
+import warnings
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TESTENV = os.path.join(REPO, "testenv")
@@ -28,12 +29,24 @@ def make_hydra_env():
     return {"usdrecord": usdrecord, "env": env}
 
 
+# An intermittent abort seen twice in one CI run of 2026-12-02 (usdrecord on grid volumes with several
+# fields, 8 renders in parallel on 2 loaded cores; "terminate called without an active exception"
+# after the render; not reproduced in 10 further runs of those tests, 40 renders, alone or three at
+# once). Open defect (see the session notes): such an abort is retried once, with a warning in the
+# test report; a second one fails the test.
+_INTERMITTENT_ABORT = "terminate called without an active exception"
+
+
 def run_usdrecord(hydra_env, args, scene_index=False, timeout=600):
     env = dict(hydra_env["env"])
     if scene_index:
         env["USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX"] = "1"
-    return subprocess.run([hydra_env["usdrecord"], "--renderer", "VolPhoton", "--disableGpu"] + [str(a) for a in args],
-                          capture_output=True, text=True, env=env, timeout=timeout)
+    cmd = [hydra_env["usdrecord"], "--renderer", "VolPhoton", "--disableGpu"] + [str(a) for a in args]
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
+    if r.returncode == -6 and _INTERMITTENT_ABORT in r.stderr:
+        warnings.warn("usdrecord aborted (%s), retried once: %s" % (_INTERMITTENT_ABORT, " ".join(cmd)))
+        r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
+    return r
 
 
 def volphoton_exe():

@@ -366,7 +366,7 @@ SPLIT_FIELDS = '''    def Volume "smoke" (
         def OpenVDBAsset "density"
         {
             asset filePath = @%(vdb)s@
-            int fieldIndex = 0
+            int fieldIndex = 1
         }
 
         def OpenVDBAsset "glow"
@@ -384,9 +384,10 @@ SPLIT_FIELDS = '''    def Volume "smoke" (
 
 
 def test_grid_fields_follow_one_set_of_rules_in_both_doors(tmp_path, hydra_env):
-    """A Volume whose density asset has no fieldName (the grid is the slot's name, "density") and an
-    authored fieldIndex, and whose emission field is in another file: both doors select the grid by
-    name with a warning naming the asset and fieldIndex, ignore the emission field with an error
+    """A Volume whose density asset has no fieldName (the grid is the slot's name, "density") and
+    fieldIndex 1, and whose emission field is in another file: both doors take the first grid of the
+    name with a warning naming the asset and fieldIndex (only there: the delegate sees 0 for an
+    unauthored fieldIndex, which must not warn), ignore the emission field with an error
     naming the glow asset and filePath, and render the same non-emissive smoke
     (core/translate/volume.h).  Without the shared rules the delegate compared paths as strings and
     never warned about fieldIndex."""
@@ -397,6 +398,8 @@ def test_grid_fields_follow_one_set_of_rules_in_both_doors(tmp_path, hydra_env):
     for door, log in (("CLI", clog), ("delegate (usdrecord)", hlog)):
         check(warning_lines(log, "/World/smoke/density", "fieldIndex", "ignored"),
               "%s: no warning naming /World/smoke/density and fieldIndex:\n%s" % (door, log[-3000:]))
+        check(not warning_lines(log, "/World/smoke/glow", "fieldIndex"),
+              "%s: a fieldIndex warning for the glow asset, which has none:\n%s" % (door, log[-3000:]))
         check(warning_lines(log, "/World/smoke/glow", "filePath", "density's file"),
               "%s: no error naming /World/smoke/glow, filePath and the one-file rule:\n%s" % (door, log[-3000:]))
     # The smoke is there (it blocks part of the unit dome) and emits nothing (the emission field is

@@ -133,7 +133,7 @@ TEST(TranslateVolume, GridFieldsSelectGridsByNameFromTheDensityFile) {
 
     MediumParams params;
     std::vector<GridFieldInput> fields = {
-        {"density", "/V/density", file, "", 0},           // no fieldName: the slot's name; fieldIndex warned
+        {"density", "/V/density", file, "", 1},           // no fieldName: the slot's name; fieldIndex 1 warned
         {"temperature", "/V/temp", alias.string(), "heat", -1},  // same file through a link: kept
         {"emission", "/V/glow", other, "density", -1},     // another file: error, ignored
     };
@@ -153,7 +153,8 @@ TEST(TranslateVolume, GridFieldsSelectGridsByNameFromTheDensityFile) {
     Diagnostics none;
     EXPECT_FALSE(gridMediumFromFields("/V", params, Affine{}, {{"density", "/V/density", "", "", -1}}, 0, none));
     EXPECT_FALSE(gridMediumFromFields("/V", params, Affine{}, {{"emission", "/V/glow", file, "", -1}}, 0, none));
-    EXPECT_TRUE(none.list().empty());
+    EXPECT_TRUE(gridMediumFromFields("/V", params, Affine{}, {{"density", "/V/density", file, "", 0}}, 0, none));
+    EXPECT_TRUE(none.list().empty());  // fieldIndex 0 is the grid taken: no warning
 
     // Loading: a missing grid is the asset's fieldName's fault, an unreadable file its filePath's.
     Diagnostics load;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <string>
 #include <system_error>
 
 #include "core/vdbGuard.h"
@@ -35,10 +36,12 @@ std::optional<GridMediumDesc> gridMediumFromFields(const std::string& volumePath
     g.densityGrid = density->fieldName.empty() ? "density" : density->fieldName;
     g.maxActiveVoxels = maxActiveVoxels;
     for (const GridFieldInput& f : fields) {
-        if (f.fieldIndex >= 0)
+        // Index 0 is the first grid of the name, which is the one taken (UsdImaging reports 0 for an
+        // unauthored fieldIndex, so 0 must not warn).
+        if (f.fieldIndex > 0)
             diag.warn(f.primPath, "fieldIndex",
-                      "fieldIndex is ignored; the grid is selected by fieldName '" +
-                          (f.fieldName.empty() ? f.slot : f.fieldName) + "'");
+                      "fieldIndex " + std::to_string(f.fieldIndex) + " is ignored; the first grid named '" +
+                          (f.fieldName.empty() ? f.slot : f.fieldName) + "' is used");
         std::string* target = f.slot == "temperature" ? &g.temperatureGrid
                               : f.slot == "emission"  ? &g.emissionGrid
                               : f.slot == "albedo"    ? &g.albedoGrid

@@ -10,7 +10,7 @@
 // | slots                | density (required), temperature, emission, albedo                          |
 // | grid name            | the asset's fieldName; the slot's name when fieldName is not authored      |
 // | one file per volume  | a field in another file than the density's: error on that field, ignored   |
-// | fieldIndex           | not used (grids are selected by name): a warning when authored             |
+// | fieldIndex           | not used (the first grid of the name is taken): a warning when above 0     |
 // | reader guard         | vdbCrashCheck before loading: a crashing file is an error, volume skipped  |
 // | load errors          | reported on the density asset (fieldName for a missing grid, else filePath)|
 #pragma once
@@ -33,7 +33,7 @@ namespace volphoton::translate {
 /// | primPath   | string |         | the OpenVDBAsset prim, for messages                              |
 /// | filePath   | string | ""      | resolved file; "" when it could not be resolved (reported there) |
 /// | fieldName  | string | ""      | the grid's name; "" when not authored                            |
-/// | fieldIndex | int    | -1      | -1 when not authored                                             |
+/// | fieldIndex | int    | -1      | -1 when not authored (the delegate sees 0 then)                  |
 struct GridFieldInput {
     std::string slot;
     std::string primPath;
