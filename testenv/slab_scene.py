@@ -68,6 +68,7 @@ RENDER_SETTINGS = '''def Scope "Render"
         rel camera = </World/cam>
         int volphoton:samplesPerPixel = {spp}
         int volphoton:seed = {seed}
+        token volphoton:integrator = "{integrator}"
     }}
 }}
 '''
@@ -82,8 +83,8 @@ def ground(w):
 
 
 def stage_text(body, settings=None):
-    """A Y-up stage whose /World holds body (prims as text); with settings (a dict of size, spp and
-    seed) a RenderSettings prim /Render/settings too."""
+    """A Y-up stage whose /World holds body (prims as text); with settings (a dict of size, spp,
+    seed and integrator) a RenderSettings prim /Render/settings too."""
     header = '#usda 1.0\n(\n    upAxis = "Y"\n%s)\n' % ('    renderSettingsPrimPath = "/Render/settings"\n' if settings else "")
     return (header + (RENDER_SETTINGS.format(**settings) if settings else "") +
             'def Xform "World"\n{\n' + textwrap.indent(body, "    ") + "}\n")

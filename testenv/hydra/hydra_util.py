@@ -29,12 +29,13 @@ def make_hydra_env():
     return {"usdrecord": usdrecord, "env": env}
 
 
-# An intermittent abort seen twice in one CI run of 2026-12-02 (usdrecord on grid volumes with several
-# fields, 8 renders in parallel on 2 loaded cores; "terminate called without an active exception"
-# after the render; not reproduced in 10 further runs of those tests, 40 renders, alone or three at
-# once). Open defect (see the session notes): such an abort is retried once, with a warning in the
-# test report; a second one fails the test.
+# An intermittent abort, "terminate called without an active exception", after usdrecord has
+# written its image (an exit-time abort): seen on 2026-12-02 in about 1 of 30 usdrecord runs inside
+# pytest (twice in one CI run, twice in three runs of test_hydra_scale.py), never in 64 plain runs of
+# the same stages nor in 40 under gdb. Open defect (session notes; README "Known gaps"): an abort
+# with that message is retried, at most twice, with a warning in the test report.
 _INTERMITTENT_ABORT = "terminate called without an active exception"
+_ABORT_RETRIES = 2
 
 
 def run_usdrecord(hydra_env, args, scene_index=False, timeout=600):
@@ -43,8 +44,12 @@ def run_usdrecord(hydra_env, args, scene_index=False, timeout=600):
         env["USDIMAGINGGL_ENGINE_ENABLE_SCENE_INDEX"] = "1"
     cmd = [hydra_env["usdrecord"], "--renderer", "VolPhoton", "--disableGpu"] + [str(a) for a in args]
     r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
-    if r.returncode == -6 and _INTERMITTENT_ABORT in r.stderr:
-        warnings.warn("usdrecord aborted (%s), retried once: %s" % (_INTERMITTENT_ABORT, " ".join(cmd)))
+    for _ in range(_ABORT_RETRIES):
+        if not (r.returncode == -6 and _INTERMITTENT_ABORT in r.stderr):
+            break
+        written = os.path.exists(str(args[-1]))
+        warnings.warn("usdrecord aborted (%s; its output %s written), retried: %s"
+                      % (_INTERMITTENT_ABORT, "was" if written else "was not", " ".join(cmd)))
         r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
     return r
 
