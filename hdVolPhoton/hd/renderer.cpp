@@ -84,23 +84,33 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
             ++_framesWritten;
         }
         auto fb = thread->LockFramebuffer();
-        _WriteAovs(preview);
+        _WriteAovs(preview, /*converged=*/false);
     }
     // Interactive: "until stopped" (the core counts passes in an int; that many is out of reach).
     int const passLimit = _interactive ? std::numeric_limits<int>::max() : _settings.samplesPerPixel;
+    bool complete = false;
     for (int pass = 0; pass < passLimit; ++pass) {
         waitWhilePaused();
         double before = renderer->stats().seconds;
         if (!renderer->renderPass(cancel)) break;
         _lastPassSeconds = renderer->stats().seconds - before;
+        complete = !_interactive && pass + 1 == _settings.samplesPerPixel;
         {
             std::lock_guard<std::mutex> lock(_statsMutex);
             _stats = renderer->stats();
-            _converged = !_interactive && pass + 1 == _settings.samplesPerPixel;
             ++_framesWritten;
         }
         auto fb = thread->LockFramebuffer();
-        _WriteAovs(renderer->film());
+        _WriteAovs(renderer->film(), complete);
+    }
+    // Converged only once every pass is written and the core renderer (and its worker threads' work)
+    // is gone: a host such as usdrecord writes the image and exits as soon as it hears it. (The flag
+    // used to be raised before the last pass was written, so the host could read the pass before
+    // it and exit while this thread was still writing.)
+    renderer.reset();
+    if (complete) {
+        std::lock_guard<std::mutex> lock(_statsMutex);
+        _converged = true;
     }
 }
 
@@ -117,8 +127,7 @@ int HdVolPhoton_Renderer::_PreviewBlock() const {
     return std::min(_settings.width, _settings.height) >= 4 * block ? block : 1;
 }
 
-void HdVolPhoton_Renderer::_WriteAovs(Film const &film) {
-    bool converged = IsConverged();
+void HdVolPhoton_Renderer::_WriteAovs(Film const &film, bool converged) {
     for (HdRenderPassAovBinding const &b : _aovBindings) {
         auto *buffer = static_cast<HdVolPhotonRenderBuffer *>(b.renderBuffer);
         if (!buffer || buffer->GetWidth() != static_cast<unsigned>(film.width()) ||

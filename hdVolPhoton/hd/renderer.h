@@ -48,7 +48,8 @@ public:
     static constexpr double PreviewAfterSeconds = 0.03, PreviewTargetSeconds = 0.01;
 
 private:
-    void _WriteAovs(volphoton::Film const &film);
+    /// Writes the film into the bound render buffers, marked converged or not.
+    void _WriteAovs(volphoton::Film const &film, bool converged);
     /// Block size of the preview before the first pass; 1: no preview.
     int _PreviewBlock() const;
 
