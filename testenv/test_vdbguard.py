@@ -95,7 +95,8 @@ def test_crash_check_without_a_probe_warns_once_and_loads_unguarded(tmp_path, gu
 
 
 def test_the_front_end_probes_every_bound_grid_with_its_voxel_cap(tmp_path, guard):
-    """crash_check_medium (the check the core runs before every grid load, core/translate/volume.h) hands the probe all the grids the load will read."""
+    """crash_check_medium (the check the core runs before every grid load, core/translate/volume.h)
+    hands the probe all the grids the load will read."""
     path = tmp_path / "f.vdb"
     path.write_bytes(b"x")
     guard.setenv(PROBE_ENV, stub_probe(tmp_path, "args", "exit 0"))
