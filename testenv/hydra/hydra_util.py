@@ -29,13 +29,14 @@ def make_hydra_env():
     return {"usdrecord": usdrecord, "env": env}
 
 
-# An intermittent abort, "terminate called without an active exception", after usdrecord has
-# written its image (an exit-time abort): seen on 2026-12-02 in about 1 of 30 usdrecord runs inside
-# pytest (twice in one CI run, twice in three runs of test_hydra_scale.py), never in 64 plain runs of
-# the same stages nor in 40 under gdb. hd/renderer.cpp then stopped reporting convergence before the
-# last pass was written (a real race, and a suspect): 0 aborts in the next 72 runs, but 1 in the
-# ~300 usdrecord runs of the next full fresh-clone run, so the cause is still open (session notes,
-# README "Known gaps"). Such an abort is retried, at most twice, with a warning in the test report.
+# An intermittent abort of usdrecord at exit, after it has written its image: "terminate called
+# without an active exception" (about 1 run in 30 to 300 inside pytest; never in 64 plain runs or
+# 40 under gdb). A core dump (2026-12-02) shows it is OpenUSD 24.08's, not the delegate's: during
+# Py_FinalizeEx a TBB worker still runs UsdImaging's detached destruction of its transform cache
+# (WorkDispatcher / Work_AsyncSwapDestroyHelper); a Tf_Remnant there takes the GIL (TfPyLock),
+# Python ends that thread with pthread_exit, and the forced unwind meets a noexcept frame. No frame
+# of hdVolPhoton is on the stack. Such an abort is retried, at most twice, with a warning in the
+# test report (README "Known gaps").
 _INTERMITTENT_ABORT = "terminate called without an active exception"
 _ABORT_RETRIES = 2
 
