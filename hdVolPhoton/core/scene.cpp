@@ -142,11 +142,21 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     rtcCommitScene(top_);
     addMeshLights();
 
+    // The media's own box too (volumes with bounds, media inside meshes): none when one is unbounded.
+    Bounds3 media;
+    bool unboundedMedium = false;
     for (int i : desc_.unboundedMedia) {
         if (i < 0 || i >= static_cast<int>(desc_.media.size())) throw std::invalid_argument("scene: unbounded medium index out of range");
         Bounds3 b = desc_.media[i]->bounds();
-        if (isFinite(b.lo) && isFinite(b.hi)) bounds.extend(b);
+        if (isFinite(b.lo) && isFinite(b.hi)) {
+            bounds.extend(b);
+            media.extend(b);
+        } else {
+            unboundedMedium = true;
+        }
     }
+    for (size_t mi = 0; mi < desc_.meshes.size(); ++mi)
+        if (desc_.meshes[mi].interiorMedium >= 0 && !meshBounds_[mi].empty()) media.extend(meshBounds_[mi]);
     for (const auto& m : desc_.media) emissiveMedia_ |= m->isEmissive();
     hasMedia_ = !desc_.unboundedMedia.empty();
     for (const auto& m : desc_.meshes) hasMedia_ |= m.interiorMedium >= 0;
@@ -178,17 +188,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     center_ = (bounds.lo + bounds.hi) * 0.5;
     radius_ = std::max(1e-6, length(bounds.hi - bounds.lo) * 0.5);
     bounds_ = bounds;
-    // Where the media are: bounded volumes and media inside meshes; none when a medium is unbounded.
-    Bounds3 media;
-    bool unbounded = false;
-    for (int i : desc_.unboundedMedia) {
-        Bounds3 b = desc_.media[i]->bounds();
-        if (isFinite(b.lo) && isFinite(b.hi)) media.extend(b);
-        else unbounded = true;
-    }
-    for (size_t mi = 0; mi < desc_.meshes.size(); ++mi)
-        if (desc_.meshes[mi].interiorMedium >= 0 && !meshBounds_[mi].empty()) media.extend(meshBounds_[mi]);
-    if (!unbounded && !media.empty()) {
+    if (!unboundedMedium && !media.empty()) {
         mediaCenter_ = (media.lo + media.hi) * 0.5;
         mediaRadius_ = std::max(1e-300, length(media.hi - media.lo) * 0.5);
     }

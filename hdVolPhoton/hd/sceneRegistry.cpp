@@ -81,12 +81,15 @@ MediumPtr HdVolPhoton_SceneRegistry::_GridMedium(SdfPath const &id, HdVolPhoton_
                                                 std::uint64_t maxGridVoxels, translate::Diagnostics &diagnostics) const {
     // The synced field Bprims as the translation layer reads them (core/translate/volume.h has the rules).
     std::vector<translate::GridFieldInput> fields;
+    std::string densityPrim;
     for (auto const &[slot, fieldId] : rec.fields) {
         auto f = _fields.find(fieldId);
-        if (f != _fields.end())
+        if (f != _fields.end()) {
             fields.push_back({slot, f->second.primPath, f->second.filePath, f->second.fieldName, f->second.fieldIndex});
-        else if (slot == "density")
+            if (slot == "density") densityPrim = f->second.primPath;
+        } else if (slot == "density") {
             diagnostics.error(id.GetString(), "field:density", "the density field prim was not synced; volume skipped");
+        }
     }
     std::optional<GridMediumDesc> g =
         translate::gridMediumFromFields(id.GetString(), rec.medium, rec.objectToWorld, fields, maxGridVoxels, diagnostics);
@@ -101,7 +104,6 @@ MediumPtr HdVolPhoton_SceneRegistry::_GridMedium(SdfPath const &id, HdVolPhoton_
         for (int c = 0; c < 4; ++c) key << g->objectToWorld.m[r][c] << ',';
     auto cached = _gridCache.find(key.str());
     if (cached != _gridCache.end()) return cached->second;
-    std::string const densityPrim = _fields.at(rec.fields.at("density")).primPath;
     MediumPtr medium = translate::loadGridMediumReported(id.GetString(), densityPrim, *g, diagnostics);
     if (medium) _gridCache[key.str()] = medium;
     return medium;
@@ -137,7 +139,7 @@ SceneDesc HdVolPhoton_SceneRegistry::BuildSceneDesc(CameraDesc const &camera, st
                     mesh.material = *m->second.material;
                 }
             }
-            if (!rec.hasMedium && rec.meshLight) mesh.material = translate::meshLightSurface(*rec.meshLight, mesh.material);
+            if (rec.meshLight) mesh.material = translate::meshLightSurface(*rec.meshLight, mesh.material);
             if (rec.hasMedium) {
                 // The medium lives in the space of the first instance (media are not instanced).
                 translate::Diagnostics diagnostics;

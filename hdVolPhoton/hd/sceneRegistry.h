@@ -34,8 +34,8 @@ struct HdVolPhoton_MeshRecord {
     HdVolPhoton_MediumSource mediumSource;  ///< set when the medium may vary in time (legacy path)
     SdfPath materialId;  ///< bound material of the faces in no subset
     std::vector<HdVolPhoton_SubsetRecord> subsets;
-    /// A mesh light (MeshLightAPI): applied to its materials when the scene is built
-    /// (translate::meshLightSurface).
+    /// A mesh light (MeshLightAPI; only on meshes without a medium, see mesh.cpp): applied to its
+    /// materials when the scene is built (translate::meshLightSurface).
     std::optional<volphoton::translate::LightResult> meshLight;
 };
 
