@@ -202,16 +202,22 @@ def test_a_mesh_light_with_unusable_values_is_named_and_the_render_goes_on(tmp_p
         assert 0.3 < m < 1, m  # lit by the panel, as with the default mode
 
 
-FURNACE = CENTRE + '''def Cube "fog" (
-    prepend apiSchemas = ["VolPhotonMediumAPI"]
-)
-{
-    double size = 5
-    float volphoton:ior = 1
-    float volphoton:density = 4
-    color3f volphoton:albedo = (1, 1, 1)
-}
-'''
+def fog_cube(size, density, albedo):
+    """An index-matched Cube of fog centred on the origin (usda text)."""
+    return textwrap.dedent('''\
+        def Cube "fog" (
+            prepend apiSchemas = ["VolPhotonMediumAPI"]
+        )
+        {
+            double size = %g
+            float volphoton:ior = 1
+            float volphoton:density = %g
+            color3f volphoton:albedo = (%g, %g, %g)
+        }
+        ''') % (size, density, albedo, albedo, albedo)
+
+
+FURNACE = CENTRE + fog_cube(5, 4, 1)
 
 
 @pytest.mark.parametrize("integrator", INTEGRATORS)
@@ -230,16 +236,7 @@ def test_white_furnace_inside_an_emissive_enclosure(tmp_path, integrator):
     assert abs(m - 1.0) <= K * se + allowance, (m, se)
 
 
-SMALL_SPHERE = CENTRE + '''def Cube "fog" (
-    prepend apiSchemas = ["VolPhotonMediumAPI"]
-)
-{
-    double size = 6
-    float volphoton:ior = 1
-    float volphoton:density = 0.3
-    color3f volphoton:albedo = (0.9, 0.9, 0.9)
-}
-def Mesh "floor"
+SMALL_SPHERE = CENTRE + fog_cube(6, 0.3, 0.9) + '''def Mesh "floor"
 {
     int[] faceVertexCounts = [4]
     int[] faceVertexIndices = [0, 3, 2, 1]
