@@ -69,7 +69,7 @@ RENDER_SETTINGS = '''def Scope "Render"
         int volphoton:samplesPerPixel = {spp}
         int volphoton:seed = {seed}
         token volphoton:integrator = "{integrator}"
-    }}
+{extra}    }}
 }}
 '''
 
@@ -84,7 +84,13 @@ def ground(w):
 
 def stage_text(body, settings=None):
     """A Y-up stage whose /World holds body (prims as text); with settings (a dict of size, spp,
-    seed and integrator) a RenderSettings prim /Render/settings too."""
+    seed and integrator, and optionally more volphoton: settings, e.g. noiseTarget=0.05) a
+    RenderSettings prim /Render/settings too."""
+    if settings:
+        fixed = ("size", "spp", "seed", "integrator")
+        extra = "".join("        %s volphoton:%s = %r\n" % ("int" if isinstance(v, int) else "double", k, v)
+                        for k, v in settings.items() if k not in fixed)
+        settings = dict({k: settings[k] for k in fixed}, extra=extra)
     header = '#usda 1.0\n(\n    upAxis = "Y"\n%s)\n' % ('    renderSettingsPrimPath = "/Render/settings"\n' if settings else "")
     return (header + (RENDER_SETTINGS.format(**settings) if settings else "") +
             'def Xform "World"\n{\n' + textwrap.indent(body, "    ") + "}\n")

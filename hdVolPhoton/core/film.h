@@ -25,7 +25,8 @@ struct PixelIds {
 };
 
 /// \class Film
-/// Sums of samples per pixel and 32-bit sample counts; resolve() divides. Rows are top to bottom.
+/// Sums of samples per pixel, the sum of the squared beauty luminance (for the noise estimate) and
+/// 32-bit sample counts; resolve() divides. Rows are top to bottom.
 /// Each pixel is written by one thread at a time (tiles do not overlap). The id images hold one
 /// PixelIds per pixel, written once per render from the pixel-centre ray (Renderer), not averaged.
 class Film {
@@ -43,6 +44,13 @@ public:
     std::vector<float> resolveAlpha() const;
     std::vector<float> resolveDepth() const;
     uint32_t samples(int x, int y) const { return count_[index(x, y)]; }
+    /// Estimated relative error of each pixel's beauty: the standard error of the mean luminance
+    /// over the pixel's samples, sqrt((E[Y^2] - E[Y]^2) / (n - 1)), divided by max(mean, floor), the
+    /// floor being ErrorFloor x the image's mean luminance (so that near-black pixels of a bright
+    /// image do not demand relative precision no viewer can see). Rows top to bottom; pixels with
+    /// fewer than 2 samples report +inf, pixels whose samples are all 0 report 0.
+    std::vector<float> resolveRelativeError() const;
+    static constexpr double ErrorFloor = 0.02;
     int width() const { return width_; }
     int height() const { return height_; }
     void clear();
@@ -54,6 +62,7 @@ private:
     int width_, height_;
     std::vector<double> rgb_[RgbAovCount];
     std::vector<double> alpha_;
+    std::vector<double> lumSq_;  ///< sum over samples of luminance(beauty)^2
     std::vector<float> depth_;
     std::vector<uint32_t> count_;
     std::vector<PixelIds> ids_;

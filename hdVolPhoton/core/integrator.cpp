@@ -2,7 +2,9 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/diagnostics.h"
 #include "core/integratorBase.h"
@@ -108,6 +110,10 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     if (!(settings_.radiusAlpha > 0 && settings_.radiusAlpha <= 1)) throw std::invalid_argument("render settings: radiusAlpha must be in (0, 1]");
     if (settings_.stratifiedDims < 0) throw std::invalid_argument("render settings: stratifiedDims must be >= 0");
     if (!(settings_.photonRadiusMfp >= 0)) throw std::invalid_argument("render settings: photonRadiusMfp must be >= 0");
+    if (!(settings_.noiseTarget >= 0) || !(settings_.timeLimit >= 0) || settings_.maxSamplesPerPixel < 1)
+        throw std::invalid_argument("render settings: noiseTarget and timeLimit must be >= 0, maxSamplesPerPixel >= 1");
+    active_.assign(static_cast<size_t>(settings_.width) * settings_.height, 1);
+    stats_.activePixels = active_.size();
     bool photonMap = settings_.integrator == RenderSettings::Integrator::PhotonMap;
     if (photonMap && !scene_->hasMedia()) {
         // Without media the photon map has nothing to add: both of its passes would be skipped and its
@@ -168,8 +174,11 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                 }
                 for (int y = ty * tile; y < std::min(settings_.height, (ty + 1) * tile); ++y)
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
-                        Rng rng(hashKeys(x, y, settings_.seed), static_cast<uint64_t>(pass_));
-                        rng.stratify(static_cast<uint32_t>(pass_), hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
+                        if (!active_[static_cast<size_t>(y) * settings_.width + x]) continue;
+                        // The pixel's own sample index (= pass_ unless adaptive sampling skipped it).
+                        uint32_t sample = film_.samples(x, y);
+                        Rng rng(hashKeys(x, y, settings_.seed), sample);
+                        rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
                         PathRadiance L;
                         if (!cameraSample(*integrator_, camera, x, y, rng, &L)) {  // never on the film: dropped, and reported
                             static std::atomic<int> reported{0};
@@ -188,10 +197,65 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
         stats_.cancelled = true;
         return false;
     }
-    stats_.cameraSamples += static_cast<uint64_t>(settings_.width) * settings_.height;
+    stats_.cameraSamples += stats_.activePixels;
     ++pass_;
     ++stats_.passes;
+    lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
+    updateAdaptive();
     return true;
+}
+
+void Renderer::updateAdaptive() {
+    if (!settings_.progressive() && pass_ < settings_.samplesPerPixel) return;  // only the stats at the end need it
+    std::vector<float> error = film_.resolveRelativeError();
+    std::vector<float> sorted = error;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    float median = sorted[sorted.size() / 2];
+    stats_.medianRelativeError = std::isinf(median) ? -1.0 : median;
+    if (settings_.noiseTarget <= 0 || pass_ < settings_.samplesPerPixel) return;
+    // A pixel stays active while it or a neighbour is above the target.
+    const int w = settings_.width, h = settings_.height;
+    uint64_t count = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            bool above = false;
+            for (int dy = -1; dy <= 1 && !above; ++dy)
+                for (int dx = -1; dx <= 1 && !above; ++dx) {
+                    int nx = x + dx, ny = y + dy;
+                    if (nx >= 0 && ny >= 0 && nx < w && ny < h) above = !(error[size_t(ny) * w + nx] <= settings_.noiseTarget);
+                }
+            active_[size_t(y) * w + x] = above;
+            count += above;
+        }
+    stats_.activePixels = count;
+}
+
+bool Renderer::finished() {
+    const char* reason = nullptr;
+    if (!settings_.progressive()) {
+        if (pass_ >= settings_.samplesPerPixel) reason = "samplesPerPixel";
+    } else if (settings_.noiseTarget > 0 && pass_ >= settings_.samplesPerPixel && stats_.activePixels == 0) {
+        reason = "noiseTarget";
+    } else if (pass_ >= settings_.maxSamplesPerPixel) {
+        reason = "maxSamplesPerPixel";
+    } else if (settings_.timeLimit > 0 && pass_ > 0 && stats_.seconds + lastPassSeconds_ > settings_.timeLimit) {
+        reason = "timeLimit";
+    }
+    if (reason) stats_.stopReason = reason;
+    return reason != nullptr;
+}
+
+int Renderer::estimatedPasses() const {
+    if (!settings_.progressive()) return settings_.samplesPerPixel;
+    double estimate = settings_.maxSamplesPerPixel;
+    if (settings_.timeLimit > 0 && pass_ > 0 && stats_.seconds > 0)
+        estimate = std::min(estimate, pass_ * settings_.timeLimit / stats_.seconds);
+    if (settings_.noiseTarget > 0 && stats_.medianRelativeError > 0) {
+        // Error falls as 1/sqrt(passes): the median pixel's passes to the target, at least the minimum.
+        double ratio = stats_.medianRelativeError / settings_.noiseTarget;
+        estimate = std::min(estimate, std::max<double>(settings_.samplesPerPixel, pass_ * ratio * ratio));
+    }
+    return std::max(pass_ + (stats_.stopReason.empty() ? 1 : 0), static_cast<int>(std::ceil(estimate)));
 }
 
 bool Renderer::renderPreview(int block, Film& preview, const CancelCallback& cancel) const {
@@ -251,9 +315,9 @@ PixelIds Renderer::pixelIds(const Camera& camera, int x, int y) const {
 }
 
 RenderStats Renderer::render(const ProgressCallback& progress, const CancelCallback& cancel) {
-    for (int i = 0; i < settings_.samplesPerPixel; ++i) {
+    while (!finished()) {
         if (!renderPass(cancel)) break;
-        if (progress) progress(i + 1, settings_.samplesPerPixel);
+        if (progress) progress(pass_, estimatedPasses());
     }
     return stats_;
 }

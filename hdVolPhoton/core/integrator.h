@@ -5,7 +5,19 @@
 // |---------------------|--------|------------|--------------|--------------------------------------------------|
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased) or photonMap                |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
-// | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass      |
+// | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
+// |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
+// |                     |        |            |              | may stop (a time limit may end the render sooner) |
+// | noiseTarget         | double | 0 (off)    | relative     | adaptive sampling: after samplesPerPixel passes a |
+// |                     |        |            | error        | pixel stops once its estimated relative error and |
+// |                     |        |            |              | its 8 neighbours' are at most this                |
+// |                     |        |            |              | (Film::resolveRelativeError); the render stops    |
+// |                     |        |            |              | when every pixel has                              |
+// | timeLimit           | double | 0 (none)   | seconds      | no pass starts that would end past this much      |
+// |                     |        |            |              | render time (photon and camera passes; at least   |
+// |                     |        |            |              | one pass runs)                                    |
+// | maxSamplesPerPixel  | int    | 4096       |              | with noiseTarget or timeLimit: the most passes    |
+// |                     |        |            |              | (samples) any pixel gets                          |
 // | maxDepth            | int    | 100000     |              | scattering/bounce events per path. The default is |
 // |                     |        |            |              | a safety cap only (Russian roulette ends paths,   |
 // |                     |        |            |              | deep ones too: integratorBase.h): unbiased. A     |
@@ -72,6 +84,11 @@ struct RenderSettings {
     Integrator integrator = Integrator::PathTracer;
     int width = 640, height = 360;
     int samplesPerPixel = 16;
+    double noiseTarget = 0;
+    double timeLimit = 0;
+    int maxSamplesPerPixel = 4096;
+    /// noiseTarget or timeLimit set: passes go on past samplesPerPixel (Renderer::finished()).
+    bool progressive() const { return noiseTarget > 0 || timeLimit > 0; }
     /// A safety cap, not a truncation: no furnace or slab test sees it (Russian roulette ends paths
     /// long before; DeepRouletteDepth in integratorBase.h ends even lossless ones).
     static constexpr int DefaultMaxDepth = 100000;
@@ -107,6 +124,13 @@ struct RenderStats {
     size_t photonMapBytes = 0;
     uint64_t photonsThinned = 0;  ///< photons dropped to stay within photonMapBudgetBytes
     uint64_t photonsRadiusCapped = 0;  ///< stored photons whose kernel the photonRadiusMfp cap narrowed
+    /// Adaptive sampling (noiseTarget): pixels still sampled after the last pass, and the median of
+    /// Film::resolveRelativeError over the image (-1 before 2 passes).
+    uint64_t activePixels = 0;
+    double medianRelativeError = -1;
+    /// Why the render stopped: "samplesPerPixel", "noiseTarget", "timeLimit", "maxSamplesPerPixel"
+    /// ("" while running or when cancelled).
+    std::string stopReason;
     std::vector<std::string> passesRun;
     std::vector<std::string> passesSkipped;  ///< "name: reason"
     bool cancelled = false;
@@ -122,6 +146,17 @@ class Integrator;
 /// pass for the photon-map integrator). Tiles run in parallel with TBB; the cancel callback is polled
 /// per tile and per photon batch. Same settings -> bit-identical film. Pass 0 also fills the film's id
 /// images from each pixel's centre ray (pixelIds()).
+///
+/// Adaptive sampling (settings.noiseTarget > 0), the same for every front end: every pixel gets
+/// samplesPerPixel passes; after each later pass a pixel keeps sampling only while its estimated
+/// relative error (Film::resolveRelativeError) or one of its 8 neighbours' is above the target (the
+/// neighbourhood keeps a lone lucky estimate from stopping a noisy region). A pixel's random stream and
+/// Sobol' index are its own sample count, so a pixel's k-th sample is the same with or without
+/// adaptivity. Stopping on the pixel's own estimate is the usual practice (Cycles, RenderMan, Arnold);
+/// the error of the converged mean it leaves is below the noise target, checked on furnace, slab and
+/// airlight scenes (testenv/test_adaptive.py). finished() says when to stop: samplesPerPixel passes
+/// without noiseTarget or timeLimit; otherwise the noise target met everywhere, the time limit, or
+/// maxSamplesPerPixel passes.
 class Renderer {
 public:
     Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings);
@@ -134,8 +169,15 @@ public:
     /// pass count and stats are untouched, so the progressive result is bit-identical with or without
     /// previews. Path traced whatever the integrator: no photon pass to wait for. False if cancelled.
     bool renderPreview(int block, Film& preview, const CancelCallback& cancel = {}) const;
-    /// Runs all samplesPerPixel passes.
+    /// Runs passes until finished(); progress(passes done, estimated passes in all) after each.
     RenderStats render(const ProgressCallback& progress = {}, const CancelCallback& cancel = {});
+    /// True when the next pass would be past the stopping rule above (stats().stopReason says which).
+    bool finished();
+    /// The passes the whole render is expected to take: samplesPerPixel, or for adaptive and
+    /// time-limited renders an estimate from the error and time so far (for progress bars).
+    int estimatedPasses() const;
+    /// Per-pixel estimated relative error (Film::resolveRelativeError), rows top to bottom.
+    std::vector<float> relativeError() const { return film_.resolveRelativeError(); }
     const Film& film() const { return film_; }
     const RenderStats& stats() const { return stats_; }
     const RenderSettings& settings() const { return settings_; }
@@ -153,6 +195,11 @@ private:
     RenderStats stats_;
     std::unique_ptr<Integrator> integrator_;
     int pass_ = 0;
+    /// Adaptive sampling: 1 where the pixel is still sampled (all 1 until samplesPerPixel passes).
+    std::vector<uint8_t> active_;
+    double lastPassSeconds_ = 0;
+    /// After a pass: the active mask and the error statistics from the film.
+    void updateAdaptive();
 };
 
 }  // namespace volphoton

@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <thread>
 
 PXR_NAMESPACE_OPEN_SCOPE
@@ -29,7 +28,7 @@ void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSe
     std::lock_guard<std::mutex> lock(_statsMutex);
     _stats = RenderStats();
     _converged = false;
-    _framesWritten = _previewBlock = 0;
+    _framesWritten = _previewBlock = _estimatedPasses = 0;
     _previewEnabled = TfGetenvBool("HDVOLPHOTON_PREVIEW", true);  // debug knob, read per restart
 }
 
@@ -55,8 +54,11 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["passesSkipped"] = VtValue(VtStringArray(_stats.passesSkipped.begin(), _stats.passesSkipped.end()));
     d["framesWritten"] = VtValue(_framesWritten);
     d["previewBlock"] = VtValue(_previewBlock);
-    if (!_interactive)
-        d["percentDone"] = VtValue(_settings.samplesPerPixel > 0 ? 100.0 * _stats.passes / _settings.samplesPerPixel : 100.0);
+    d["activePixels"] = VtValue(static_cast<uint64_t>(_stats.activePixels));
+    d["medianRelativeError"] = VtValue(_stats.medianRelativeError);
+    d["stopReason"] = VtValue(_stats.stopReason);
+    if (!_interactive || _settings.progressive())
+        d["percentDone"] = VtValue(_converged ? 100.0 : _estimatedPasses > 0 ? 100.0 * _stats.passes / _estimatedPasses : 0.0);
     return d;
 }
 
@@ -86,18 +88,21 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
         auto fb = thread->LockFramebuffer();
         _WriteAovs(preview, /*converged=*/false);
     }
-    // Interactive: "until stopped" (the core counts passes in an int; that many is out of reach).
-    int const passLimit = _interactive ? std::numeric_limits<int>::max() : _settings.samplesPerPixel;
-    bool complete = false;
-    for (int pass = 0; pass < passLimit; ++pass) {
+    // A batch render ends where the core's stopping rule says (samplesPerPixel, or the noise target,
+    // time limit or sample cap); an interactive one too when a noise target or time limit is set,
+    // otherwise it goes on until stopped.
+    bool const stops = !_interactive || _settings.progressive();
+    bool complete = stops && renderer->finished();
+    while (!complete) {
         waitWhilePaused();
         double before = renderer->stats().seconds;
         if (!renderer->renderPass(cancel)) break;
         _lastPassSeconds = renderer->stats().seconds - before;
-        complete = !_interactive && pass + 1 == _settings.samplesPerPixel;
+        complete = stops && renderer->finished();
         {
             std::lock_guard<std::mutex> lock(_statsMutex);
             _stats = renderer->stats();
+            _estimatedPasses = renderer->estimatedPasses();
             ++_framesWritten;
         }
         auto fb = thread->LockFramebuffer();

@@ -24,10 +24,13 @@ PXR_NAMESPACE_OPEN_SCOPE
 /// after every pass under the framebuffer lock. Pausing is honoured between passes.
 ///
 /// Batch or interactive (HdVolPhotonRenderDelegate::IsInteractive, enableInteractive): a batch
-/// render (usdrecord) stops after exactly samplesPerPixel passes and then reports converged; an
-/// interactive one (usdview) keeps adding passes until it is stopped or restarted and never reports
-/// converged, so the viewer keeps drawing. Stats: numCompletedSamples (usdview's HUD key) = passes;
-/// percentDone only in a batch render (an interactive one has no end).
+/// render (usdrecord) stops where the core's stopping rule says (volphoton::Renderer::finished():
+/// samplesPerPixel passes, or with volphoton:noiseTarget / volphoton:timeLimit the noise target met
+/// everywhere, the time limit or maxSamplesPerPixel) and then reports converged; an interactive one
+/// (usdview) does the same when a noise target or time limit is set, and otherwise keeps adding
+/// passes until it is stopped or restarted and never reports converged, so the viewer keeps drawing.
+/// Stats: numCompletedSamples (usdview's HUD key) = passes; activePixels, medianRelativeError,
+/// stopReason (RenderStats); percentDone where the render has an end.
 ///
 /// Interactive restarts: before the first pass, when the last full pass took longer than
 /// PreviewAfterSeconds (or no pass was timed yet), a coarse preview (volphoton::Renderer::renderPreview:
@@ -62,6 +65,7 @@ private:
     bool _converged = false;
     bool _interactive = false;  ///< passes go on past samplesPerPixel until stopped
     int _framesWritten = 0, _previewBlock = 0;
+    int _estimatedPasses = 0;  ///< volphoton::Renderer::estimatedPasses() after the last pass
     bool _previewEnabled = true;
     double _lastPassSeconds = -1;  ///< render thread only; kept across restarts (-1: none timed yet)
 };

@@ -38,6 +38,9 @@ py::dict statsToDict(const RenderStats& s) {
     d["passes_run"] = s.passesRun;
     d["passes_skipped"] = s.passesSkipped;
     d["cancelled"] = s.cancelled;
+    d["active_pixels"] = s.activePixels;
+    d["median_relative_error"] = s.medianRelativeError;
+    d["stop_reason"] = s.stopReason;
     return d;
 }
 
@@ -47,6 +50,9 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["width"] = s.width;
     d["height"] = s.height;
     d["samplesPerPixel"] = s.samplesPerPixel;
+    d["noiseTarget"] = s.noiseTarget;
+    d["timeLimit"] = s.timeLimit;
+    d["maxSamplesPerPixel"] = s.maxSamplesPerPixel;
     d["maxDepth"] = s.maxDepth;
     d["rouletteDepth"] = s.rouletteDepth;
     d["seed"] = s.seed;
@@ -178,6 +184,9 @@ void bindRender(py::module_& m) {
         .def_readwrite("width", &RenderSettings::width)
         .def_readwrite("height", &RenderSettings::height)
         .def_readwrite("samples_per_pixel", &RenderSettings::samplesPerPixel)
+        .def_readwrite("noise_target", &RenderSettings::noiseTarget)
+        .def_readwrite("time_limit", &RenderSettings::timeLimit)
+        .def_readwrite("max_samples_per_pixel", &RenderSettings::maxSamplesPerPixel)
         .def_readwrite("max_depth", &RenderSettings::maxDepth)
         .def_readwrite("roulette_depth", &RenderSettings::rouletteDepth)
         .def_readwrite("seed", &RenderSettings::seed)
@@ -219,6 +228,8 @@ void bindRender(py::module_& m) {
                 for (int x = 0; x < f.width(); ++x) w(y, x) = f.samples(x, y);
             return a;
         })
+        .def("relative_error", [](const Film& f) { return imageArray(f.resolveRelativeError(), f.width(), f.height(), 1); },
+             "(H, W) float32 estimated relative error of the beauty (Film::resolveRelativeError; inf below 2 samples)")
         .def_property_readonly("beauty", [](const Film& f) { return imageArray(f.resolveRgb(Film::Beauty), f.width(), f.height(), 3); })
         .def_property_readonly("single", [](const Film& f) { return imageArray(f.resolveRgb(Film::Single), f.width(), f.height(), 3); })
         .def_property_readonly("multiple", [](const Film& f) { return imageArray(f.resolveRgb(Film::Multiple), f.width(), f.height(), 3); })
@@ -246,7 +257,10 @@ void bindRender(py::module_& m) {
             state.rethrow();
             return statsToDict(stats);
         }, py::arg("progress") = py::none(), py::arg("cancel") = py::none(),
-           "Runs all passes; progress(done, total) after each, cancel() -> bool polled per tile. Returns stats.")
+           "Runs passes until finished() (samplesPerPixel, or the noise target / time limit / sample cap); "
+           "progress(done, estimated total) after each, cancel() -> bool polled per tile. Returns stats.")
+        .def("finished", &Renderer::finished, "True when the stopping rule says no further pass (stats['stop_reason'])")
+        .def("estimated_passes", &Renderer::estimatedPasses)
         .def("render_pass", [](Renderer& r, const py::object& cancel) {
             CallbackState state;
             state.cancel = callableOrNull(cancel, "cancel");

@@ -51,7 +51,18 @@ std::vector<SettingInfo> makeTable() {
                  [](const RS& s) { return AttrValue(integratorName(s.integrator)); },
                  [](RS& s, const AttrValue& v) { parseIntegrator(std::get<std::string>(v), &s.integrator); }});
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
-                           "passes; one camera sample per pixel per pass", &RS::samplesPerPixel));
+                           "passes; one camera sample per pixel per pass (with a noise target: the passes every pixel "
+                           "gets before it may stop)", &RS::samplesPerPixel));
+    t.push_back(doubleSetting("noiseTarget", 0, 1e3, "--noise-target", "Noise target (0: off)", "relative error",
+                              "adaptive sampling: after samplesPerPixel passes, pixels stop once their estimated "
+                              "relative error (and their neighbours') is at most this, e.g. 0.03", &RS::noiseTarget));
+    t.push_back(doubleSetting("timeLimit", 0, Big, "--time-limit", "Time limit (0: none)", "seconds",
+                              "render time limit: no pass starts that would end past it (at least one pass)",
+                              &RS::timeLimit));
+    t.push_back(intSetting("maxSamplesPerPixel", 1, Big, "--max-spp", "volphoton:maxSamplesPerPixel",
+                           "Max samples per pixel (noise target, time limit)", "",
+                           "with a noise target or time limit: the most passes any pixel gets",
+                           &RS::maxSamplesPerPixel));
     t.push_back(intSetting("maxDepth", 0, Big, "--max-depth", "volphoton:maxDepth", "Max depth", "events",
                            "scattering/bounce events per path; the default is a safety cap (unbiased), lower values are "
                            "an artistic control and BIASED (dense bright media darken)", &RS::maxDepth));

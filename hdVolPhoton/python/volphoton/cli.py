@@ -11,11 +11,17 @@ Usage
 
 Outputs
     ``-o`` gets a multi-layer OpenEXR (beauty R,G,B,A and the AOV layers single, multiple, emission,
-    surface, depth.Z; see volphoton/output.py).  A display-referred PNG is written next to it (same
+    surface, depth.Z, error.Y (estimated relative error), samples.Y; see volphoton/output.py).  A display-referred PNG is written next to it (same
     name, .png) through OpenColorIO: the built-in sRGB config, or ``$OCIO`` with ``--display`` /
     ``--view``.  ``--png`` names it (.jpg also works), ``--no-png`` skips it.  ``--stats`` writes a JSON
     with per-pass timings, samples, photons, passes run/skipped and why, the settings used, peak RSS
     and wall time.
+
+Noise and time: ``--noise-target 0.03`` samples each pixel until its estimated relative error (and
+its neighbours') is at most 3%, after ``--spp`` passes for every pixel and at most ``--max-spp``;
+``--time-limit S`` stops before a pass would end past S seconds of rendering; both may be given
+(whichever comes first).  The summary and ``--stats`` report the median estimated error and why the
+render stopped.
 
 Settings, in priority order: the command line, ``volphoton:<name>`` attributes of the stage's
 UsdRender Settings prim (names of integrator.h, e.g. ``int volphoton:samplesPerPixel = 8``), the
@@ -522,7 +528,7 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
     label = "frame %s" % frame if frame is not None else "render"
     if count > 1:
         label += " (%d/%d)" % (index + 1, count)
-    progress.begin(label, settings.samples_per_pixel)
+    progress.begin(label, renderer.estimated_passes())
     rstats = renderer.render(progress=progress.update)
     progress.end()
     t3 = _time.perf_counter()
@@ -556,9 +562,14 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
         raise RenderError(str(e))
     t4 = _time.perf_counter()
     counts = reporter.counts()
-    reporter.info("%s: %dx%d, %d spp, %s, %.2f s -> %s%s" % (
-        _when(frame, tc), settings.width, settings.height, rstats["passes"], settings.to_dict()["integrator"],
+    error = rstats["median_relative_error"]
+    reporter.info("%s: %dx%d, %d passes (%s), median estimated error %s, %s, %.2f s -> %s%s" % (
+        _when(frame, tc), settings.width, settings.height, rstats["passes"], _STOP_REASONS.get(rstats["stop_reason"], "?"),
+        "%.1f%%" % (100 * error) if error >= 0 else "n/a", settings.to_dict()["integrator"],
         t4 - t0, exr_path, (", " + png_path) if png_path else ""))
+    if index == 0 and not args.quiet:
+        reporter.info("EXR layers: R,G,B,A beauty; single, multiple, emission, surface (the light-path split); "
+                      "depth.Z; error.Y (estimated relative error); samples.Y")
     passes = [{"pass": i + 1, "seconds": s} for i, s in enumerate(progress.pass_times)]
     return {
         "frame": frame,
@@ -583,6 +594,9 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "photon_map_bytes": rstats["photon_map_bytes"],
             "photons_thinned": rstats["photons_thinned"],
             "photons_radius_capped": rstats["photons_radius_capped"],
+            "active_pixels": rstats["active_pixels"],
+            "median_relative_error": rstats["median_relative_error"],
+            "stop_reason": rstats["stop_reason"],
             "passes_run": rstats["passes_run"],
             "passes_skipped": rstats["passes_skipped"],
         },
@@ -590,6 +604,10 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
         "diagnostics": {"errors": counts["error"], "warnings": counts["warning"],
                         "messages": list(reporter.frame_messages)},
     }
+
+
+_STOP_REASONS = {"samplesPerPixel": "all samples", "noiseTarget": "noise target met",
+                 "timeLimit": "time limit", "maxSamplesPerPixel": "sample cap (--max-spp)"}
 
 
 def _isfinite(a):

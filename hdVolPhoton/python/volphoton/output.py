@@ -8,6 +8,11 @@ EXR layout (32-bit float, ZIP compression, written by the core's OpenEXR writer)
     emission.R/G/B             volume emission seen directly
     surface.R/G/B              surfaces, lights and environment seen through the media
     depth.Z                    camera distance to the first surface (+inf where none)
+    error.Y                    estimated relative error of the beauty's luminance per pixel
+                               (core Film::resolveRelativeError; -1 where a pixel has < 2 samples)
+    samples.Y                  camera samples the pixel got (adaptive sampling varies it)
+    denoised.R/G/B             only with ``--denoise``: the beauty through Open Image Denoise
+    albedo.R/G/B, normal.R/G/B only with ``--denoise``: the denoiser's guides (volphoton/denoise.py)
 
 String header attributes: ``software``, ``volphoton:scene``, ``volphoton:camera``,
 ``volphoton:frame``, ``volphoton:settings`` (JSON of the render settings).
@@ -58,6 +63,9 @@ def film_planes(film) -> Dict[str, np.ndarray]:
         for i, c in enumerate("RGB"):
             planes["%s.%s" % (layer, c)] = np.ascontiguousarray(rgb[:, :, i])
     planes["depth.Z"] = film.depth()
+    error = film.relative_error()
+    planes["error.Y"] = np.where(np.isfinite(error), error, -1.0).astype(np.float32)
+    planes["samples.Y"] = film.samples().astype(np.float32)
     return planes
 
 
