@@ -189,19 +189,21 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                     }
             }
     });
+    if (!cancelled) {
+        stats_.cameraSamples += stats_.activePixels;
+        ++pass_;
+        ++stats_.passes;
+        updateAdaptive();  // timed with the pass: the time limit counts it
+    }
     auto end = std::chrono::steady_clock::now();
     stats_.photonSeconds += std::chrono::duration<double>(photonsDone - start).count();
     stats_.cameraSeconds += std::chrono::duration<double>(end - photonsDone).count();
     stats_.seconds += std::chrono::duration<double>(end - start).count();
+    lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
     if (cancelled) {
         stats_.cancelled = true;
         return false;
     }
-    stats_.cameraSamples += stats_.activePixels;
-    ++pass_;
-    ++stats_.passes;
-    lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
-    updateAdaptive();
     return true;
 }
 

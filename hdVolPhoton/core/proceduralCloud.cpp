@@ -1,5 +1,7 @@
 #include "core/proceduralCloud.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include <openvdb/io/File.h>
@@ -52,9 +54,63 @@ double fractalNoise(uint64_t seed, double x, double y, double z) {
     return sum / norm;
 }
 
+/// Distance from p to the nearest of one jittered feature point per unit cell (Worley's cellular
+/// basis F1), over the 27 cells around p; about [0, 1].
+double worley(uint64_t seed, double x, double y, double z) {
+    double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
+    double best = 1e9;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                int64_t i = static_cast<int64_t>(fx) + dx, j = static_cast<int64_t>(fy) + dy, k = static_cast<int64_t>(fz) + dz;
+                double px = i + 0.5 + 0.5 * latticeValue(seed, i, j, k), py = j + 0.5 + 0.5 * latticeValue(seed + 1, i, j, k),
+                       pz = k + 0.5 + 0.5 * latticeValue(seed + 2, i, j, k);
+                best = std::min(best, (px - x) * (px - x) + (py - y) * (py - y) + (pz - z) * (pz - z));
+            }
+    return std::sqrt(best);
+}
+
+/// Billows: inverted Worley noise at three octaves (weights 0.625, 0.25, 0.125), in [0, 1], high
+/// inside puffs.
+double billows(uint64_t seed, double x, double y, double z) {
+    double sum = 0, f = 1;
+    const double weight[3] = {0.625, 0.25, 0.125};
+    for (int o = 0; o < 3; ++o, f *= 2.0)
+        sum += weight[o] * std::clamp(1.0 - worley(mix64(seed + 101 * o), x * f, y * f, z * f), 0.0, 1.0);
+    return sum;
+}
+
+inline double smoothstep(double a, double b, double x) {
+    double t = std::clamp((x - a) / (b - a), 0.0, 1.0);
+    return t * t * (3 - 2 * t);
+}
+
+/// Cumulus density at u (the unit ball's coordinates, y up): a heap of puffs on a flat base whose
+/// coverage is carved by billows and eroded at the edges by fBm (Schneider and Vos 2015's remap).
+double cumulusDensity(uint64_t seed, double ux, double uy, double uz) {
+    // The heap: a wide low puff, a tall central tower and two shoulders (union of ellipsoids).
+    struct Puff { double x, y, z, rx, ry, rz; };
+    static const Puff puffs[] = {{0.0, -0.30, 0.0, 0.85, 0.38, 0.62}, {0.05, 0.05, 0.0, 0.48, 0.55, 0.45},
+                                 {-0.40, -0.12, 0.10, 0.38, 0.36, 0.36}, {0.42, -0.15, -0.08, 0.36, 0.32, 0.34}};
+    double shape = 0;
+    for (const Puff& p : puffs) {
+        double dx = (ux - p.x) / p.rx, dy = (uy - p.y) / p.ry, dz = (uz - p.z) / p.rz;
+        shape = std::max(shape, 1.0 - (dx * dx + dy * dy + dz * dz));
+    }
+    if (shape <= 0) return 0;
+    shape *= smoothstep(-0.62, -0.50, uy);  // the flat base
+    double b = billows(seed, 3.2 * ux + 5.0, 3.2 * uy + 9.0, 3.2 * uz + 13.0);
+    // Remap (Schneider and Vos): coverage that the billows' gaps do not reach is cut away.
+    double carved = (shape - (1.0 - b) * 0.55) / std::max(1e-6, 1.0 - (1.0 - b) * 0.55);
+    if (carved <= 0) return 0;
+    double wisps = 0.5 + 0.5 * fractalNoise(seed ^ 0x77697370ULL, 9.0 * ux, 9.0 * uy, 9.0 * uz);
+    double eroded = carved - 0.25 * (1.0 - carved) * wisps;
+    return std::clamp(eroded * 3.0, 0.0, 1.0);
+}
+
 }  // namespace
 
-void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed) {
+void writeProceduralCloudVdb(const std::string& path, int resolution, double voxelSize, uint64_t seed, CloudShape shape) {
     if (resolution < 1) throw std::invalid_argument("writeProceduralCloudVdb: resolution must be >= 1");
     if (!(voxelSize > 0) || !std::isfinite(voxelSize))
         throw std::invalid_argument("writeProceduralCloudVdb: voxelSize must be finite and > 0");
@@ -78,8 +134,13 @@ void writeProceduralCloudVdb(const std::string& path, int resolution, double vox
                         double ux = (i - centre) / radius, uy = (j - centre) / radius, uz = (k - centre) / radius;
                         double r2 = ux * ux + uy * uy + uz * uz;
                         if (r2 >= 1) continue;
-                        double n = fractalNoise(noiseSeed, 2.5 * ux + 17.0, 2.5 * uy + 31.0, 2.5 * uz + 47.0);
-                        double d = (1.0 - r2) * (0.45 + 1.2 * n) * 1.4 - 0.08;
+                        double d;
+                        if (shape == CloudShape::Cumulus) {
+                            d = cumulusDensity(noiseSeed, ux, uy, uz);
+                        } else {
+                            double n = fractalNoise(noiseSeed, 2.5 * ux + 17.0, 2.5 * uy + 31.0, 2.5 * uz + 47.0);
+                            d = (1.0 - r2) * (0.45 + 1.2 * n) * 1.4 - 0.08;
+                        }
                         if (d <= 0) continue;
                         acc.setValue(Coord(i, j, k), static_cast<float>(std::min(d, 1.0)));
                     }

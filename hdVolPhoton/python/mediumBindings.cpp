@@ -162,11 +162,18 @@ void bindMedia(py::module_& m) {
         return loadGridMedium(copy);
     }, py::arg("desc"),
           "Opens desc.file_path and builds the medium; RuntimeError naming the file and grid on failure.");
-    m.def("write_procedural_cloud_vdb", [](const std::string& path, int resolution, double voxelSize, uint64_t seed) {
+    m.def("write_procedural_cloud_vdb", [](const std::string& path, int resolution, double voxelSize, uint64_t seed,
+                                           const std::string& shape) {
+        CloudShape s;
+        if (shape == "blob") s = CloudShape::Blob;
+        else if (shape == "cumulus") s = CloudShape::Cumulus;
+        else throw py::value_error("write_procedural_cloud_vdb: shape must be 'blob' or 'cumulus', not '" + shape + "'");
         py::gil_scoped_release release;
-        writeProceduralCloudVdb(path, resolution, voxelSize, seed);
+        writeProceduralCloudVdb(path, resolution, voxelSize, seed, s);
     }, py::arg("path"), py::arg("resolution") = 64, py::arg("voxel_size") = 1.0 / 64, py::arg("seed") = 1,
-          "Deterministic procedural cloud FloatGrid 'density' (see proceduralCloud.h).");
+          py::arg("shape") = "blob",
+          "Deterministic procedural cloud FloatGrid 'density' (see proceduralCloud.h): shape 'blob' (tests, "
+          "benchmark) or 'cumulus' (the example scenes).");
     m.def("blackbody_color", &blackbodyColor, py::arg("kelvin"));
     m.def("blackbody_radiance", &blackbodyRadiance, py::arg("kelvin"));
 }
