@@ -120,6 +120,9 @@ PYTHON=${PYTHON:-python3}
 . .venv/bin/activate
 pip install -q --upgrade pip
 pip install -q "scikit-build-core>=0.10" "pybind11>=2.12" numpy "usd-core>=24.8" Pillow pytest jinja2 iadpython scipy matplotlib
+# Optional: Intel Open Image Denoise for `volphoton render --denoise` (the `oidn` wheel ships the
+# library; volphoton/denoise.py loads it). Without it --denoise says what to install.
+pip install -q oidn || echo "setup: the optional denoiser (pip package oidn) could not be installed; --denoise will say so"
 echo "setup: building and installing the volphoton Python package (C++ core + bindings)"
 CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-$(nproc)} pip install -q --no-build-isolation .
 

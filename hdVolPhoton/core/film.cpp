@@ -23,7 +23,7 @@ void Film::clear() {
 
 void Film::add(int x, int y, const PathRadiance& r) {
     size_t i = index(x, y);
-    const Spectrum parts[RgbAovCount] = {r.beauty(), r.single, r.multiple, r.emission, r.surface};
+    const Spectrum parts[RgbAovCount] = {r.beauty(), r.single, r.multiple, r.emission, r.surface, r.albedo, r.normal};
     for (int a = 0; a < RgbAovCount; ++a)
         for (int c = 0; c < 3; ++c) rgb_[a][3 * i + c] += parts[a][c];
     alpha_[i] += r.alpha;

@@ -13,6 +13,9 @@ namespace volphoton {
 /// beauty() is their sum by construction.
 struct PathRadiance {
     Spectrum single, multiple, emission, surface;
+    /// Denoiser guides (RenderSettings::guideAovs; Integrator::firstVertexGuides): the albedo and the
+    /// camera-facing normal at the camera path's first vertex. Not part of beauty().
+    Spectrum albedo, normal;
     double alpha = 0;          ///< 1 when the first segment met a surface or a medium interaction
     double depth = Infinity;   ///< camera distance to the first surface (infinity if none)
     Spectrum beauty() const { return single + multiple + emission + surface; }
@@ -31,7 +34,7 @@ struct PixelIds {
 /// PixelIds per pixel, written once per render from the pixel-centre ray (Renderer), not averaged.
 class Film {
 public:
-    enum Aov { Beauty, Single, Multiple, Emission, Surface, RgbAovCount };
+    enum Aov { Beauty, Single, Multiple, Emission, Surface, Albedo, Normal, RgbAovCount };
     enum IdAov { ObjectId, InstanceId, ElementId };
     Film(int width, int height);
     void add(int x, int y, const PathRadiance& r);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/diagnostics.h"
+#include "core/freeFlight.h"
 #include "core/integratorBase.h"
 
 namespace volphoton {
@@ -102,6 +103,51 @@ PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stac
     return seg;
 }
 
+void Integrator::firstVertexGuides(const Ray& cameraRay, double nearClip, double farClip, Rng& rng, Spectrum* albedo,
+                                   Spectrum* normal) const {
+    *albedo = Spectrum(0.0);
+    *normal = Spectrum(0.0);
+    PathRay path{cameraRay, nearClip, farClip, nearClip};
+    MediumStack stack = cameraStack_;
+    auto facing = [&](const Vec3& n) { *normal = Spectrum(n.x, n.y, n.z); };
+    for (int crossings = 0; crossings < MaxBoundaryCrossings; ++crossings) {
+        PathSegment ahead = nextSegment(path, stack, /*cameraRay=*/true);
+        if (scene_.hasMedia()) {
+            MediumAggregate media = scene_.mediaFor(stack);
+            if (media.size()) {
+                Ray local{path.ray.at(path.mediumFrom), path.ray.d};
+                bool collided = false;
+                double length = std::isinf(ahead.tEnd) ? 1e30 : ahead.tEnd - path.mediumFrom;
+                sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
+                    Spectrum sigma_t = e.mp.sigma_t();
+                    if (rng.uniform() * e.sigmaMaj >= sigma_t.average()) return true;  // a null collision
+                    for (int c = 0; c < 3; ++c) (*albedo)[c] = sigma_t[c] > 0 ? e.mp.sigma_s[c] / sigma_t[c] : 0.0;
+                    collided = true;
+                    return false;
+                });
+                if (collided) return facing(-path.ray.d);
+            }
+        }
+        if (ahead.leavesHole()) {
+            path.leaveHole(stack, ahead.leakExit);
+            continue;
+        }
+        if (ahead.reachesLight()) {
+            for (int c = 0; c < 3; ++c) (*albedo)[c] = std::clamp(ahead.lightLe[c], 0.0, 1.0);
+            return facing(-path.ray.d);
+        }
+        if (!ahead.hasHit) return;
+        const SurfaceMaterial& m = scene_.mesh(ahead.hit.mesh).material;
+        if (m.kind == SurfaceMaterial::Kind::Boundary) {
+            SurfaceScatter s = scatterSurface(path.ray, ahead.hit, stack, rng, /*radianceMode=*/true);
+            path.passBoundary(s, ahead.hit.t);
+            continue;
+        }
+        *albedo = m.kind == SurfaceMaterial::Kind::Lambertian ? m.albedo : Spectrum(1.0);
+        return facing(dot(ahead.hit.ns, path.ray.d) > 0 ? -ahead.hit.ns : ahead.hit.ns);
+    }
+}
+
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings)
     : scene_(std::move(scene)), settings_(settings), film_(settings.width, settings.height) {
     if (settings_.samplesPerPixel < 0) throw std::invalid_argument("render settings: samplesPerPixel must be >= 0");
@@ -142,10 +188,14 @@ std::unique_ptr<tbb::global_control> limitThreads(const RenderSettings& settings
 /// One camera sample of pixel (x, y): a jittered position in it and the integrator's radiance.
 /// false (and an empty result) when a numerical accident made the radiance non-finite or negative:
 /// such a sample must never reach a film.
-bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int y, Rng& rng, PathRadiance* L) {
+/// guides: also the denoiser guides of the same camera ray, from their own stream (guideRng), so
+/// that the beauty is the same with or without them.
+bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int y, Rng& rng, PathRadiance* L,
+                  Rng* guideRng = nullptr) {
     double tMin, tMax;
     Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
     *L = integrator.Li(ray, tMin, tMax, rng);
+    if (guideRng) integrator.firstVertexGuides(ray, tMin, tMax, *guideRng, &L->albedo, &L->normal);
     if (L->beauty().isFinite() && L->beauty().minValue() >= 0) return true;
     *L = PathRadiance();
     return false;
@@ -180,7 +230,9 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                         Rng rng(hashKeys(x, y, settings_.seed), sample);
                         rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
                         PathRadiance L;
-                        if (!cameraSample(*integrator_, camera, x, y, rng, &L)) {  // never on the film: dropped, and reported
+                        Rng guideRng(hashKeys(x, y, settings_.seed, 0x6775696465ULL), sample);  // "guide"
+                        if (!cameraSample(*integrator_, camera, x, y, rng, &L, settings_.guideAovs ? &guideRng : nullptr)) {
+                            // never on the film: dropped, and reported
                             static std::atomic<int> reported{0};
                             if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
                         }

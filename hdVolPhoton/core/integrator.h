@@ -51,6 +51,9 @@
 // |                     |        |            |              | power scaled up (unbiased), and the stats say so  |
 // | maxGridVoxels       | uint64 | 2^30       | voxels       | VDB grids with more active voxels are refused     |
 // |                     |        |            |              | (warned; the volume is skipped); 0: no cap        |
+// | guideAovs           | bool   | false      |              | fill the albedo and normal AOVs (denoiser guides) |
+// |                     |        |            |              | from one extra first-vertex ray per sample (its   |
+// |                     |        |            |              | own random stream: the beauty is unchanged)       |
 // | domeVisibleToCamera | bool   | true       |              | false: camera rays that escape (straight through  |
 // |                     |        |            |              | media and index-matched boundaries) see black and |
 // |                     |        |            |              | alpha 0; the dome still lights the scene (Hydra's |
@@ -65,6 +68,12 @@
 //  - surface:  everything whose first vertex is a surface (lambertian or dielectric), plus lights and
 //              the environment seen directly through the media.
 // beauty = single + multiple + emission + surface, in both integrators.
+// With guideAovs, two more for a denoiser (Integrator::firstVertexGuides, the same for both
+// integrators): albedo and normal at the first vertex of the camera path that is not an
+// index-matched boundary (a lambertian surface: its albedo and its normal turned to the camera; a
+// dielectric: albedo 1, as Open Image Denoise's documentation asks of specular surfaces; a medium
+// collision: the single-scattering albedo sigma_s / sigma_t and the normal -ray direction; a light or
+// the sky: its radiance clamped to [0, 1] and -ray direction).
 #pragma once
 
 #include <atomic>
@@ -108,6 +117,7 @@ struct RenderSettings {
     double transmittanceCutoff = 0;
     size_t photonMapBudgetBytes = size_t(1) << 30;
     bool domeVisibleToCamera = true;
+    bool guideAovs = false;
     /// Grid-size cap applied when front ends load VDB grids (GridMediumDesc::maxActiveVoxels); 0 = none.
     std::uint64_t maxGridVoxels = std::uint64_t(1) << 30;
 };

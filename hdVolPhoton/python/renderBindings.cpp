@@ -69,6 +69,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["transmittanceCutoff"] = s.transmittanceCutoff;
     d["photonMapBudgetBytes"] = s.photonMapBudgetBytes;
     d["domeVisibleToCamera"] = s.domeVisibleToCamera;
+    d["guideAovs"] = s.guideAovs;
     return d;
 }
 
@@ -203,6 +204,7 @@ void bindRender(py::module_& m) {
         .def_readwrite("transmittance_cutoff", &RenderSettings::transmittanceCutoff)
         .def_readwrite("photon_map_budget_bytes", &RenderSettings::photonMapBudgetBytes)
         .def_readwrite("dome_visible_to_camera", &RenderSettings::domeVisibleToCamera)
+        .def_readwrite("guide_aovs", &RenderSettings::guideAovs)
         .def_readwrite("max_grid_voxels", &RenderSettings::maxGridVoxels)
         .def("to_dict", &settingsToDict, "Settings under their documented (integrator.h) names")
         .def("__repr__", [](const RenderSettings& s) { return py::repr(settingsToDict(s)).cast<std::string>(); });
@@ -213,7 +215,9 @@ void bindRender(py::module_& m) {
         .value("Single", Film::Single)
         .value("Multiple", Film::Multiple)
         .value("Emission", Film::Emission)
-        .value("Surface", Film::Surface);
+        .value("Surface", Film::Surface)
+        .value("Albedo", Film::Albedo)
+        .value("Normal", Film::Normal);
     film.def_property_readonly("width", &Film::width)
         .def_property_readonly("height", &Film::height)
         .def("rgb", [](const Film& f, Film::Aov aov) { return imageArray(f.resolveRgb(aov), f.width(), f.height(), 3); },
@@ -234,7 +238,11 @@ void bindRender(py::module_& m) {
         .def_property_readonly("single", [](const Film& f) { return imageArray(f.resolveRgb(Film::Single), f.width(), f.height(), 3); })
         .def_property_readonly("multiple", [](const Film& f) { return imageArray(f.resolveRgb(Film::Multiple), f.width(), f.height(), 3); })
         .def_property_readonly("emission", [](const Film& f) { return imageArray(f.resolveRgb(Film::Emission), f.width(), f.height(), 3); })
-        .def_property_readonly("surface", [](const Film& f) { return imageArray(f.resolveRgb(Film::Surface), f.width(), f.height(), 3); });
+        .def_property_readonly("surface", [](const Film& f) { return imageArray(f.resolveRgb(Film::Surface), f.width(), f.height(), 3); })
+        .def_property_readonly("albedo", [](const Film& f) { return imageArray(f.resolveRgb(Film::Albedo), f.width(), f.height(), 3); },
+                               "denoiser guide (RenderSettings.guide_aovs; zero without it)")
+        .def_property_readonly("normal", [](const Film& f) { return imageArray(f.resolveRgb(Film::Normal), f.width(), f.height(), 3); },
+                               "denoiser guide (RenderSettings.guide_aovs; zero without it)");
 
     py::class_<Renderer, std::shared_ptr<Renderer>>(m, "Renderer")
         .def(py::init([](std::shared_ptr<Scene> scene, const RenderSettings& settings) {

@@ -95,6 +95,9 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(doubleSetting("multipleThreshold", 0, Big, "", "Multiple-scattering threshold", "",
                               "photonMap: skip photons when a pilot estimates multiple/single below this",
                               &RS::multipleThreshold));
+    t.push_back(boolSetting("guideAovs", "", "Denoiser guide AOVs (albedo, normal)",
+                            "fill the albedo and normal AOVs a denoiser uses (one extra first-vertex ray per sample; "
+                            "the CLI's --denoise turns it on)", &RS::guideAovs));
     t.push_back(doubleSetting("transmittanceCutoff", 0, 1, "", "Transmittance cut-off (biased)", "",
                               "deterministic early termination below this transmittance (BIASED; 0: off)",
                               &RS::transmittanceCutoff));

@@ -13,7 +13,9 @@ Outputs
     ``-o`` gets a multi-layer OpenEXR (beauty R,G,B,A and the AOV layers single, multiple, emission,
     surface, depth.Z, error.Y (estimated relative error), samples.Y; see volphoton/output.py).  A display-referred PNG is written next to it (same
     name, .png) through OpenColorIO: the built-in sRGB config, or ``$OCIO`` with ``--display`` /
-    ``--view``.  ``--png`` names it (.jpg also works), ``--no-png`` skips it.  ``--stats`` writes a JSON
+    ``--view``.  ``--png`` names it (.jpg also works), ``--no-png`` skips it.  ``--denoise`` adds a
+    ``denoised`` layer (Open Image Denoise, an optional install: volphoton/denoise.py) with its
+    ``albedo`` and ``normal`` guides and makes the PNG from it; the beauty is never replaced.  ``--stats`` writes a JSON
     with per-pass timings, samples, photons, passes run/skipped and why, the settings used, peak RSS
     and wall time.
 
@@ -68,6 +70,8 @@ import resource
 import sys
 import time as _time
 from typing import Dict, List, Optional
+
+import numpy as np
 
 from . import __version__, register_usd_plugin
 
@@ -338,6 +342,9 @@ def build_parser() -> argparse.ArgumentParser:
     png = r.add_mutually_exclusive_group()
     png.add_argument("--png", metavar="OUT.png", help="display image (default: the EXR name with .png)")
     png.add_argument("--no-png", action="store_true", help="do not write the display image")
+    r.add_argument("--denoise", action="store_true",
+                   help="also write a 'denoised' layer (Intel Open Image Denoise, optional: 'pip install oidn') and "
+                        "the albedo/normal guides it used, and make the PNG from it; the EXR's beauty stays as rendered")
     r.add_argument("--display", default="", help="OCIO display (with $OCIO; default: the config's default)")
     r.add_argument("--view", default="", help="OCIO view (default: the display's default view)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary (warnings still print)")
@@ -473,6 +480,13 @@ def cmd_render(args) -> int:
         width, height = (tuple(args.resolution) if args.resolution else rs_info.resolution or DEFAULT_RESOLUTION)
         camera_path = args.camera or rs_info.camera_path
         settings = _settings(core, args, rs_info, width, height)
+        if args.denoise:
+            from . import denoise
+
+            reason = denoise.available()
+            if reason:
+                raise UsageError("--denoise: " + reason)
+            settings.guide_aovs = True
         frames = _frame_times(stage, args.frames)
         if any(f is None for f, _ in frames) and (has_placeholder(args.output) or has_placeholder(args.png)):
             raise UsageError("-o %s has a frame placeholder but no frame is given: use --frames" % args.output)
@@ -543,6 +557,16 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             if k != "depth.Z":
                 v[~_isfinite(v)] = 0.0
         beauty[~_isfinite(beauty)] = 0.0
+    if args.denoise:
+        from . import denoise
+
+        albedo, normal = renderer.film.albedo, renderer.film.normal
+        for name, image in (("albedo", albedo), ("normal", normal)):
+            for i, c in enumerate("RGB"):
+                planes["%s.%s" % (name, c)] = np.ascontiguousarray(image[:, :, i])
+        beauty = denoise.denoise(beauty, albedo, normal)
+        for i, c in enumerate("RGB"):
+            planes["denoised.%s" % c] = np.ascontiguousarray(beauty[:, :, i])
     exr_path = expand_frame(args.output, frame)
     png_path = None
     if display is not None:
@@ -569,7 +593,8 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
         t4 - t0, exr_path, (", " + png_path) if png_path else ""))
     if index == 0 and not args.quiet:
         reporter.info("EXR layers: R,G,B,A beauty; single, multiple, emission, surface (the light-path split); "
-                      "depth.Z; error.Y (estimated relative error); samples.Y")
+                      "depth.Z; error.Y (estimated relative error); samples.Y%s"
+                      % ("; denoised (the PNG's image), albedo, normal (its guides)" if args.denoise else ""))
     passes = [{"pass": i + 1, "seconds": s} for i, s in enumerate(progress.pass_times)]
     return {
         "frame": frame,
@@ -611,8 +636,6 @@ _STOP_REASONS = {"samplesPerPixel": "all samples", "noiseTarget": "noise target 
 
 
 def _isfinite(a):
-    import numpy as np
-
     return np.isfinite(a)
 
 
