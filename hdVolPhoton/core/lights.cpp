@@ -3,6 +3,7 @@
 #include <ImfArray.h>
 #include <ImfRgbaFile.h>
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,6 +21,34 @@ double spotFalloff(double cosAngle, double coneAngle, double coneSoftness) {
     if (angle >= coneAngle) return 0.0;
     double x = (coneAngle - angle) / (coneAngle - inner);
     return x * x * (3 - 2 * x);
+}
+
+bool coneInterval(const Ray& ray, const Vec3& apex, const Vec3& axis, double halfAngle, double* t0, double* t1) {
+    *t0 = -Infinity;
+    *t1 = Infinity;
+    Vec3 o = ray.o - apex;
+    double c2 = std::cos(halfAngle) * std::cos(halfAngle);
+    double ad = dot(axis, ray.d), ao = dot(axis, o);
+    // (a.x)^2 - cos^2 |x|^2 >= 0 on x = o + t d: A t^2 + B t + C >= 0 (both nappes), then a.x >= 0.
+    double A = ad * ad - c2, B = 2 * (ad * ao - c2 * dot(ray.d, o)), C = ao * ao - c2 * lengthSquared(o);
+    double disc = B * B - 4 * A * C;
+    if (std::abs(A) < 1e-9) return true;  // (nearly) along the cone's surface: keep the whole line
+    // No real root: with A < 0 the line misses both nappes (at most grazes them); A > 0 cannot miss
+    // (rounding): keep the whole line.
+    if (disc < 0) return A > 0;
+    double q = std::sqrt(disc);
+    double r1 = (-B - q) / (2 * A), r2 = (-B + q) / (2 * A);
+    if (r1 > r2) std::swap(r1, r2);
+    if (A < 0) {  // inside between the roots, on one nappe
+        if (ao + 0.5 * (r1 + r2) * ad < 0) return false;
+        *t0 = r1;
+        *t1 = r2;
+    } else if (ad > 0) {  // the positive nappe is where the line goes forward
+        *t0 = r2;
+    } else {
+        *t1 = r1;
+    }
+    return true;
 }
 
 namespace {
@@ -168,6 +197,17 @@ public:
     bool isDelta() const override { return r_ == 0; }
     std::optional<Vec3> pointPosition() const override { return r_ == 0 ? std::optional<Vec3>(p_) : std::nullopt; }
     std::optional<Vec3> equiangularCenter() const override { return p_; }
+    void litInterval(const Ray& ray, double* t0, double* t1) const override {
+        *t0 = -Infinity;
+        *t1 = Infinity;
+        // A cone narrower than a hemisphere; its apex moved back along the axis by r / sin(angle)
+        // contains the sphere, hence every emission direction from any point of it (widened by a
+        // hair against rounding: the interval must not cut light off).
+        double angle = std::min(cone_ * (1 + 1e-6) + 1e-9, 0.5 * Pi * (1 - 1e-6));
+        if (!shaped_ || cone_ >= 0.5 * Pi * (1 - 1e-6)) return;
+        Vec3 apex = p_ - axis_ * (r_ * (1 + 1e-6) / std::sin(angle) + 1e-9 * (1 + length(p_)));
+        if (!coneInterval(ray, apex, axis_, angle, t0, t1)) *t0 = *t1 = Infinity;  // empty
+    }
     Spectrum power(double) const override {
         // Point: 4 pi I; sphere: pi L * 4 pi r^2. Spot shaping scales by the cone's solid-angle share,
         // approximated by its hard cone (used for light selection and photon budgets only).

@@ -77,6 +77,14 @@ public:
     virtual std::optional<Vec3> pointPosition() const { return std::nullopt; }
     /// Centre towards which equiangular sampling aims (point, spot and sphere lights); nullopt for others.
     virtual std::optional<Vec3> equiangularCenter() const { return std::nullopt; }
+    /// The interval [*t0, *t1] of the line ray.o + t ray.d outside which this light sends no light
+    /// to any point (a spot's cone, widened to contain its sphere), so that distance sampling towards
+    /// the light may keep to it. Conservative (a superset); default: the whole line.
+    virtual void litInterval(const Ray& ray, double* t0, double* t1) const {
+        (void)ray;
+        *t0 = -Infinity;
+        *t1 = Infinity;
+    }
     /// Total emitted power (W); sceneRadius bounds the scene for distant and dome lights.
     virtual Spectrum power(double sceneRadius) const = 0;
     virtual PhotonEmission emitPhoton(const PhotonAim& aim, double u[4]) const = 0;
@@ -118,5 +126,11 @@ LightPtr makeMeshLight(const std::string& name, std::vector<Vec3> points, const 
 
 /// UsdLux ShapingAPI cone falloff: 1 inside coneAngle*(1-softness), smoothstep to 0 at coneAngle.
 double spotFalloff(double cosAngle, double coneAngle, double coneSoftness);
+
+/// The t interval [*t0, *t1] (possibly half-infinite) where the line ray.o + t ray.d (ray.d unit) lies
+/// inside the single cone {x : angle(x - apex, axis) <= halfAngle}, axis unit, halfAngle in (0, pi/2);
+/// false when the line misses it. A line through the apex or along the cone's surface gets the whole
+/// line (true, conservative).
+bool coneInterval(const Ray& ray, const Vec3& apex, const Vec3& axis, double halfAngle, double* t0, double* t1);
 
 }  // namespace volphoton

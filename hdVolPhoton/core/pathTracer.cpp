@@ -225,8 +225,20 @@ private:
         return sigma * std::exp(-tau);
     }
 
-    /// Equiangular density (Kulla and Fajardo 2012) of t in [a, b] for the point light `light`.
-    double equiangularPdf(int light, const Ray& ray, const Support& s, double t) const {
+    /// The part of the segment's support the light can reach (Light::litInterval: a spot's cone):
+    /// equiangular sampling keeps to it, so a narrow beam crossed far from the light's nearest point
+    /// is not missed (the fog around testenv/fog_spotlight.usda's beam was lit by rare, large
+    /// samples: 53% of a pixel's multiple scattering came from its 10 largest of 4096 samples).
+    Support litSupport(int light, const Ray& ray, const Support& s) const {
+        double t0, t1;
+        scene_.lights()[light]->litInterval(ray, &t0, &t1);
+        return {std::max(s.a, t0), std::min(s.b, t1)};
+    }
+
+    /// Equiangular density (Kulla and Fajardo 2012) of t in the lit part [a, b] of the support for
+    /// the point light `light`.
+    double equiangularPdf(int light, const Ray& ray, const Support& support, double t) const {
+        Support s = litSupport(light, ray, support);
         if (!(s.b > s.a) || t < s.a || t > s.b) return 0;
         Vec3 lp = pointLightPosition_[light];
         double delta = dot(lp - ray.o, ray.d), D = length(lp - ray.at(delta));
@@ -237,13 +249,15 @@ private:
 
     /// The equiangular strategy: one point light picked by power, one distance along the segment,
     /// camera-side transmittance by ratio tracking, MIS weight against distance sampling.
-    Spectrum equiangularPointLight(const Medium& media, const Ray& ray, const Support& s, const MediumStack& stack,
+    Spectrum equiangularPointLight(const Medium& media, const Ray& ray, const Support& support, const MediumStack& stack,
                                    const Spectrum& beta, Rng& rng) const {
         double pick;
         size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
         double u = rng.uniform();
         auto [u1, u2] = rng.uniform2();
-        if (!isPointLight(static_cast<int>(li)) || !(s.b > s.a)) return {};
+        if (!isPointLight(static_cast<int>(li))) return {};
+        Support s = litSupport(static_cast<int>(li), ray, support);
+        if (!(s.b > s.a)) return {};
         Vec3 lp = pointLightPosition_[li];
         double delta = dot(lp - ray.o, ray.d), D = length(lp - ray.at(delta));
         double t;
@@ -254,7 +268,7 @@ private:
             double thA = std::atan2(s.a - delta, D), thB = std::atan2(s.b - delta, D);
             t = delta + D * std::tan(thA + u * (thB - thA));
         }
-        double pe = equiangularPdf(static_cast<int>(li), ray, s, t);
+        double pe = equiangularPdf(static_cast<int>(li), ray, support, t);
         if (!(pe > 0) || !std::isfinite(t)) return {};
         Vec3 p = ray.at(t);
         MediumProperties mp = media.properties(p);
