@@ -16,25 +16,13 @@
 
 using namespace volphoton;
 using volphoton::test::meanAndError;
+using volphoton::test::lookAt;
 using volphoton::test::smallSettings;
 
 namespace {
 constexpr int Seeds = 16;
 using Kind = RenderSettings::Integrator;
 
-CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov) {
-    Vec3 f = normalize(target - eye), up(0, 1, 0);
-    Vec3 x = normalize(cross(f, up)), y = cross(x, f);
-    CameraDesc c;
-    for (int r = 0; r < 3; ++r) {
-        c.cameraToWorld.m[r][0] = x[r];
-        c.cameraToWorld.m[r][1] = y[r];
-        c.cameraToWorld.m[r][2] = -f[r];
-        c.cameraToWorld.m[r][3] = eye[r];
-    }
-    c.tanHalfFovX = tanHalfFov;
-    return c;
-}
 
 /// A unit cube of sigma_t 2, albedo 0.8, isotropic, under a dome of radiance 1, filling about half of
 /// a 16 x 16 image: bright dome pixels with no noise, noisy medium pixels, edges between them.

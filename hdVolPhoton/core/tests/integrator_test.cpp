@@ -16,25 +16,12 @@ using namespace volphoton;
 using volphoton::test::meanAndError;
 using volphoton::test::aovMean;
 using volphoton::test::imageMean;
+using volphoton::test::lookAt;
 using volphoton::test::smallSettings;
 
 namespace {
 constexpr int Seeds = 16;
 
-CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov = 0.6) {
-    Vec3 f = normalize(target - eye);  // camera looks down -Z
-    Vec3 up = std::abs(f.y) > 0.99 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
-    Vec3 x = normalize(cross(f, up)), y = cross(x, f);
-    CameraDesc c;
-    for (int r = 0; r < 3; ++r) {
-        c.cameraToWorld.m[r][0] = x[r];
-        c.cameraToWorld.m[r][1] = y[r];
-        c.cameraToWorld.m[r][2] = -f[r];
-        c.cameraToWorld.m[r][3] = eye[r];
-    }
-    c.tanHalfFovX = tanHalfFov;
-    return c;
-}
 
 
 /// Renders one image per seed and returns per-pixel beauty channel c (or an AOV) for each seed.

@@ -11,6 +11,22 @@ namespace volphoton::test {
 
 constexpr int RenderSeeds = 16;
 
+/// A pinhole camera at eye looking at target (y up; x up when looking straight along y).
+inline CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov = 0.6) {
+    Vec3 f = normalize(target - eye);  // camera looks down -Z
+    Vec3 up = std::abs(f.y) > 0.99 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+    Vec3 x = normalize(cross(f, up)), y = cross(x, f);
+    CameraDesc c;
+    for (int r = 0; r < 3; ++r) {
+        c.cameraToWorld.m[r][0] = x[r];
+        c.cameraToWorld.m[r][1] = y[r];
+        c.cameraToWorld.m[r][2] = -f[r];
+        c.cameraToWorld.m[r][3] = eye[r];
+    }
+    c.tanHalfFovX = tanHalfFov;
+    return c;
+}
+
 /// 8x8 pixels, deep paths, a modest photon map: the settings every statistical image test starts from.
 inline RenderSettings smallSettings(RenderSettings::Integrator integrator, int spp, uint64_t seed) {
     RenderSettings s;
