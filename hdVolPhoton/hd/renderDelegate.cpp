@@ -200,7 +200,8 @@ HdAovDescriptor HdVolPhotonRenderDelegate::GetDefaultAovDescriptor(TfToken const
     if (name == HdAovTokens->depth) return HdAovDescriptor(HdFormatFloat32, false, VtValue(1.0f));
     if (name == HdAovTokens->primId || name == HdAovTokens->instanceId || name == HdAovTokens->elementId)
         return HdAovDescriptor(HdFormatInt32, false, VtValue(-1));
-    for (char const *split : {"single", "multiple", "emission", "surface"})
+    // The light-path split and the denoiser guides (albedo; normal is Hydra's world-space "normal").
+    for (char const *split : {"single", "multiple", "emission", "surface", "albedo", "normal"})
         if (name == split) return HdAovDescriptor(HdFormatFloat32Vec3, false, VtValue(GfVec3f(0.0f)));
     return HdAovDescriptor();
 }

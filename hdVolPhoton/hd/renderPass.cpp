@@ -90,6 +90,9 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
     }
     settings.width = width;
     settings.height = height;
+    // The denoiser guides cost a ray per sample: traced only when an albedo or normal AOV is bound.
+    for (HdRenderPassAovBinding const &b : aovs)
+        if (b.aovName == "albedo" || b.aovName == HdAovTokens->normal) settings.guideAovs = true;
     for (HdRenderPassAovBinding const &b : aovs)
         if (b.renderBuffer) {
             auto *buffer = static_cast<HdVolPhotonRenderBuffer *>(b.renderBuffer);

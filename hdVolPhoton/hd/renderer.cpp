@@ -167,7 +167,8 @@ void HdVolPhoton_Renderer::_WriteAovs(Film const &film, bool converged) {
             buffer->WriteInts(film.resolveIds(Film::ElementId));
         } else {
             static const std::pair<char const *, Film::Aov> split[] = {
-                {"single", Film::Single}, {"multiple", Film::Multiple}, {"emission", Film::Emission}, {"surface", Film::Surface}};
+                {"single", Film::Single}, {"multiple", Film::Multiple}, {"emission", Film::Emission}, {"surface", Film::Surface},
+                {"albedo", Film::Albedo}, {"normal", Film::Normal}};
             for (auto const &[aov, which] : split)
                 if (name == aov) buffer->WriteFloats(film.resolveRgb(which), 3);
         }

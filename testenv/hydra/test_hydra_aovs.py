@@ -1,9 +1,13 @@
-"""The id AOVs (primId, instanceId, elementId) through UsdImagingGLEngine, read back by the small C++
-tool build/hdVolPhoton/hd/hdVolPhotonIdImages (OpenUSD 24.08's Python cannot map a render buffer)."""
+"""The id AOVs (primId, instanceId, elementId) and the denoiser guides (albedo, normal) through
+UsdImagingGLEngine, read back by the small C++ tool build/hdVolPhoton/hd/hdVolPhotonIdImages
+(OpenUSD 24.08's Python cannot map a render buffer)."""
 
 import json
+import math
 import os
 import subprocess
+
+import pytest
 
 from hydra_util import BUILD
 
@@ -103,3 +107,51 @@ def test_id_aovs_name_the_prims_the_pixels_see(tmp_path, hydra_env):
     for aov in ("primId", "instanceId", "elementId"):
         assert at(aov, -2.0, 1.0) == -1 and at(aov, 0.0, 0.4) == -1 and at(aov, 2.0, -1.0) == -1
         assert d[aov].count(-1) > W * H // 2
+
+
+GUIDE_SCENE = """#usda 1.0
+(
+    upAxis = "Y"
+)
+def Xform "World"
+{
+    def Camera "camera"
+    {
+        float focalLength = 50
+        float horizontalAperture = 20.955
+        float verticalAperture = 10.4775
+        double3 xformOp:translate = (0, 0, 10)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+    def Mesh "wall"
+    {
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(-3, -2, 0), (0, -2, 0), (0, 2, 0), (-3, 2, 0)]
+        color3f[] primvars:displayColor = [(0.2, 0.4, 0.6)]
+        uniform token subdivisionScheme = "none"
+    }
+    def DomeLight "sky"
+    {
+        float inputs:intensity = 1
+    }
+}
+"""
+
+
+def test_denoiser_guide_aovs_albedo_and_normal(tmp_path, hydra_env):
+    """The albedo and normal AOVs (the denoiser guides, core Integrator::firstVertexGuides) through
+    the delegate: bound, they are traced; the wall's pixels hold its displayColor and its normal +z
+    (facing the camera), the same for every sample (a lambertian first vertex: no noise)."""
+    assert os.path.exists(TOOL), "the id-image tool was not built (usdImagingGL and OpenGL::GL are needed)"
+    scene = tmp_path / "guides.usda"
+    scene.write_text(GUIDE_SCENE)
+    p = subprocess.run([TOOL, str(scene), "/World/camera", str(W), str(H), "albedo", "normal"], capture_output=True,
+                       text=True, env=hydra_env["env"], timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    d = json.loads(p.stdout)
+    c, r = pixel(-1.5, 0.0)
+    i = 3 * (r * W + c)
+    assert d["albedo"][i:i + 3] == pytest.approx([0.2, 0.4, 0.6], abs=1e-5)
+    assert d["normal"][i:i + 3] == pytest.approx([0.0, 0.0, 1.0], abs=1e-5)
+    assert all(math.isfinite(v) for v in d["albedo"] + d["normal"])

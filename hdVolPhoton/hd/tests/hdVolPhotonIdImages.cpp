@@ -4,7 +4,9 @@
 // does it in C++: HdRenderBuffer::Map.
 //
 //   hdVolPhotonIdImages SCENE.usda CAMERA_PATH WIDTH HEIGHT
+//   hdVolPhotonIdImages SCENE.usda CAMERA_PATH WIDTH HEIGHT AOV...   (float3 AOVs instead, e.g. albedo normal)
 //
+// With AOV names it prints {"width", "height", "<aov>": [r, g, b, r, g, b, ...] (rows top to bottom)}.
 // Prints {"width", "height", "primId": [...], "instanceId": [...], "elementId": [...] (rows top to
 // bottom), "hits": [{"primId", "instanceId", "path", "instancer", "instanceIndex"}, ...]} where hits
 // decodes every (primId, instanceId) pair seen with UsdImagingGLEngine::DecodeIntersection.
@@ -33,9 +35,11 @@ PXR_NAMESPACE_USING_DIRECTIVE
 
 namespace {
 
-/// The AOV `aov` once the render has converged, rows top to bottom; empty on failure.
-std::vector<int32_t> RenderIdAov(UsdImagingGLEngine &engine, UsdStageRefPtr const &stage, TfToken const &aov, int width,
-                                 int height) {
+/// The AOV `aov` (channels values of type T a pixel, Hydra format `format`) once the render has
+/// converged, rows top to bottom; empty on failure.
+template <typename T>
+std::vector<T> RenderAov(UsdImagingGLEngine &engine, UsdStageRefPtr const &stage, TfToken const &aov, int width,
+                         int height, HdFormat format, int channels) {
     if (!engine.SetRendererAov(aov)) return {};
     UsdImagingGLRenderParams params;
     auto start = std::chrono::steady_clock::now();
@@ -45,18 +49,25 @@ std::vector<int32_t> RenderIdAov(UsdImagingGLEngine &engine, UsdStageRefPtr cons
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     } while (!engine.IsConverged());
     HdRenderBuffer *buffer = engine.GetAovRenderBuffer(aov);
-    if (!buffer || buffer->GetFormat() != HdFormatInt32 || buffer->GetWidth() != static_cast<unsigned>(width) ||
+    if (!buffer || buffer->GetFormat() != format || buffer->GetWidth() != static_cast<unsigned>(width) ||
         buffer->GetHeight() != static_cast<unsigned>(height))
         return {};
-    std::vector<int32_t> out(static_cast<size_t>(width) * height);
-    auto const *data = static_cast<int32_t const *>(buffer->Map());
+    size_t row = static_cast<size_t>(width) * channels;
+    std::vector<T> out(row * height);
+    auto const *data = static_cast<T const *>(buffer->Map());
     for (int y = 0; y < height; ++y)  // Hydra's row 0 is the bottom
-        std::memcpy(out.data() + static_cast<size_t>(y) * width, data + static_cast<size_t>(height - 1 - y) * width, 4 * width);
+        std::memcpy(out.data() + y * row, data + (height - 1 - y) * row, sizeof(T) * row);
     buffer->Unmap();
     return out;
 }
 
-void PrintArray(char const *name, std::vector<int32_t> const &v) {
+std::vector<int32_t> RenderIdAov(UsdImagingGLEngine &engine, UsdStageRefPtr const &stage, TfToken const &aov, int width,
+                                 int height) {
+    return RenderAov<int32_t>(engine, stage, aov, width, height, HdFormatInt32, 1);
+}
+
+template <typename T>
+void PrintArray(char const *name, std::vector<T> const &v) {
     std::cout << "\"" << name << "\": [";
     for (size_t i = 0; i < v.size(); ++i) std::cout << (i ? "," : "") << v[i];
     std::cout << "]";
@@ -65,8 +76,8 @@ void PrintArray(char const *name, std::vector<int32_t> const &v) {
 }  // namespace
 
 int main(int argc, char **argv) {
-    if (argc != 5) {
-        std::cerr << "usage: hdVolPhotonIdImages SCENE.usda CAMERA_PATH WIDTH HEIGHT\n";
+    if (argc < 5) {
+        std::cerr << "usage: hdVolPhotonIdImages SCENE.usda CAMERA_PATH WIDTH HEIGHT [AOV...]\n";
         return 1;
     }
     int width = std::atoi(argv[3]), height = std::atoi(argv[4]);
@@ -89,6 +100,20 @@ int main(int argc, char **argv) {
     engine.SetRenderBufferSize(GfVec2i(width, height));
     engine.SetFraming(CameraUtilFraming(GfRect2i(GfVec2i(0, 0), width, height)));
 
+    if (argc > 5) {  // float3 AOVs
+        std::cout << "{\"width\": " << width << ", \"height\": " << height;
+        for (int i = 5; i < argc; ++i) {
+            std::vector<float> image = RenderAov<float>(engine, stage, TfToken(argv[i]), width, height, HdFormatFloat32Vec3, 3);
+            if (image.empty()) {
+                std::cerr << "no converged " << argv[i] << " render buffer\n";
+                return 1;
+            }
+            std::cout << ", ";
+            PrintArray(argv[i], image);
+        }
+        std::cout << "}" << std::endl;
+        return 0;
+    }
     std::map<TfToken, std::vector<int32_t>> images;
     for (TfToken const &aov : {HdAovTokens->primId, HdAovTokens->instanceId, HdAovTokens->elementId}) {
         images[aov] = RenderIdAov(engine, stage, aov, width, height);
