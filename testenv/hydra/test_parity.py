@@ -1085,6 +1085,13 @@ SETTING_CASES = {
     "multipleScattering": ("bool volphoton:multipleScattering = 0", PHOTON_MAP, "darker"),
     "multipleThreshold": ("float volphoton:multipleThreshold = 1000000", PHOTON_MAP, "darker"),
     "transmittanceCutoff": ("float volphoton:transmittanceCutoff = 0.5", [], "pixels"),
+    # Adaptive sampling: an unreachable target renders to the cap (32 passes instead of SPP); a cap
+    # ends a render whose target is unreachable earlier than the default 4096; a time limit renders
+    # past SPP; the guides have their own random stream, so the beauty is bit-identical.
+    "noiseTarget": ("float volphoton:noiseTarget = 0.001", ["int volphoton:maxSamplesPerPixel = 32"], "pixels"),
+    "maxSamplesPerPixel": ("int volphoton:maxSamplesPerPixel = 24", ["float volphoton:noiseTarget = 0.001"], "pixels"),
+    "timeLimit": ("float volphoton:timeLimit = 0.5", [], "pixels"),
+    "guideAovs": ("bool volphoton:guideAovs = 1", [], "same"),
     # Not in SETTINGS_ATTRIBUTES (the CLI reads it beside them): the 16^3 cloud has more than 10
     # active voxels, so it is refused (an error naming it) and the picture changes.
     "maxGridVoxels": ("int volphoton:maxGridVoxels = 10", [], "changes"),
