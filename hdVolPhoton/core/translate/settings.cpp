@@ -69,7 +69,7 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(intSetting("rouletteDepth", 0, Big, "", "volphoton:rouletteDepth", "Russian roulette depth", "events",
                            "events before Russian roulette may end a path", &RS::rouletteDepth));
     t.push_back({"seed", SettingType::Int, 0, 9.2e18, {}, "--seed", "volphoton:seed", "Seed", "",
-                 "every random stream hashes (pixel, pass, seed)",
+                 "every random stream hashes (pixel, the pixel's sample index, seed)",
                  [](const RS& s) { return AttrValue(int64_t(s.seed)); },
                  [](RS& s, const AttrValue& v) { s.seed = uint64_t(num(v)); }});
     t.push_back(intSetting("threads", 0, 4096, "--threads", "threadLimit", "Thread limit (0: all cores)", "",
