@@ -11,13 +11,13 @@ Usage
 
 Outputs
     ``-o`` gets a multi-layer OpenEXR (beauty R,G,B,A and the AOV layers single, multiple, emission,
-    surface, depth.Z, error.Y (estimated relative error), samples.Y; see volphoton/output.py).  A display-referred PNG is written next to it (same
-    name, .png) through OpenColorIO: the built-in sRGB config, or ``$OCIO`` with ``--display`` /
-    ``--view``.  ``--png`` names it (.jpg also works), ``--no-png`` skips it.  ``--denoise`` adds a
-    ``denoised`` layer (Open Image Denoise, an optional install: volphoton/denoise.py) with its
-    ``albedo`` and ``normal`` guides and makes the PNG from it; the beauty is never replaced.  ``--stats`` writes a JSON
-    with per-pass timings, samples, photons, passes run/skipped and why, the settings used, peak RSS
-    and wall time.
+    surface, depth.Z, error.Y (estimated relative error), samples.Y; see volphoton/output.py).  A
+    display-referred PNG is written next to it (same name, .png) through OpenColorIO: the built-in
+    sRGB config, or ``$OCIO`` with ``--display`` / ``--view``.  ``--png`` names it (.jpg also works),
+    ``--no-png`` skips it.  ``--denoise`` adds a ``denoised`` layer (Open Image Denoise, an optional
+    install: volphoton/denoise.py) with its ``albedo`` and ``normal`` guides and makes the PNG from
+    it; the beauty is never replaced.  ``--stats`` writes a JSON with per-pass timings, samples,
+    photons, passes run/skipped and why, the settings used, peak RSS and wall time.
 
 Noise and time: ``--noise-target 0.03`` samples each pixel until its estimated relative error (and
 its neighbours') is at most 3%, after ``--spp`` passes for every pixel and at most ``--max-spp``;
