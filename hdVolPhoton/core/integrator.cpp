@@ -138,13 +138,15 @@ void Integrator::firstVertexGuides(const Ray& cameraRay, double nearClip, double
         }
         if (!ahead.hasHit) return;
         const SurfaceMaterial& m = scene_.mesh(ahead.hit.mesh).material;
-        if (m.kind == SurfaceMaterial::Kind::Boundary) {
-            SurfaceScatter s = scatterSurface(path.ray, ahead.hit, stack, rng, /*radianceMode=*/true);
-            path.passBoundary(s, ahead.hit.t);
-            continue;
+        if (m.kind == SurfaceMaterial::Kind::Lambertian) {
+            *albedo = m.albedo;
+            return facing(dot(ahead.hit.ns, path.ray.d) > 0 ? -ahead.hit.ns : ahead.hit.ns);
         }
-        *albedo = m.kind == SurfaceMaterial::Kind::Lambertian ? m.albedo : Spectrum(1.0);
-        return facing(dot(ahead.hit.ns, path.ray.d) > 0 ? -ahead.hit.ns : ahead.hit.ns);
+        // A boundary is crossed; a smooth dielectric is specular: the guides come from the first
+        // non-specular vertex after it, along the reflection or refraction Fresnel picks.
+        SurfaceScatter s = scatterSurface(path.ray, ahead.hit, stack, rng, /*radianceMode=*/true);
+        if (m.kind == SurfaceMaterial::Kind::Boundary) path.passBoundary(s, ahead.hit.t);
+        else path.bounce(s.next, s.tMin);
     }
 }
 

@@ -70,11 +70,11 @@
 //              the environment seen directly through the media.
 // beauty = single + multiple + emission + surface, in both integrators.
 // With guideAovs, two more for a denoiser (Integrator::firstVertexGuides, the same for both
-// integrators): albedo and normal at the first vertex of the camera path that is not an
-// index-matched boundary (a lambertian surface: its albedo and its normal turned to the camera; a
-// dielectric: albedo 1, as Open Image Denoise's documentation asks of specular surfaces; a medium
-// collision: the single-scattering albedo sigma_s / sigma_t and the normal -ray direction; a light or
-// the sky: its radiance clamped to [0, 1] and -ray direction).
+// integrators): albedo and normal at the first non-specular vertex of the camera path (index-matched
+// boundaries are crossed and smooth dielectrics followed along the reflection or refraction Fresnel
+// picks; then a lambertian surface gives its albedo and its normal turned to the camera, a medium
+// collision the single-scattering albedo sigma_s / sigma_t and the normal -ray direction, a light or
+// the sky its radiance clamped to [0, 1] and -ray direction).
 #pragma once
 
 #include <atomic>

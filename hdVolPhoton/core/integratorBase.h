@@ -119,9 +119,9 @@ public:
     }
     virtual PathRadiance Li(const Ray& ray, double tMin, double tMax, Rng& rng) const = 0;
     /// The denoiser guides of a camera ray (integrator.h, "AOVs"): *albedo and *normal at its first
-    /// vertex other than an index-matched boundary; the medium collision is sampled with the free-flight
-    /// routine (a real collision accepted with probability average sigma_t / sigma_maj). Black and
-    /// zero where the ray escapes into nothing.
+    /// non-specular vertex (through boundaries and smooth dielectrics); a medium collision is sampled
+    /// with the free-flight routine (a real collision accepted with probability average sigma_t /
+    /// sigma_maj). Black and zero where the ray escapes into nothing.
     void firstVertexGuides(const Ray& ray, double tMin, double tMax, Rng& rng, Spectrum* albedo, Spectrum* normal) const;
 
 protected:

@@ -302,6 +302,41 @@ TEST(DenoiserGuides, AlbedoAndNormalAtTheFirstVertexAndTheBeautyUnchanged) {
     EXPECT_TRUE(std::all_of(zero.begin(), zero.end(), [](float v) { return v == 0; }));
 }
 
+TEST(DenoiserGuides, GlassIsLookedThroughToTheFirstNonSpecularVertex) {
+    // A closed glass cube (n = 1.5) between the camera and the wall of the test above, no fog: a guide
+    // ray is reflected to the sky (albedo = the dome's radiance 1, clamped) or refracted on to the
+    // wall (0.3, 0.4, 0.5), so the centre pixel's albedo is f (1, 1, 1) + (1 - f) (0.3, 0.4, 0.5) with
+    // one reflected fraction f in red and blue, a few per cent at near-normal incidence (Fresnel:
+    // 4% a face, plus internal reflections). Treating the glass itself as the vertex gives f = 1.
+    SceneDesc d;
+    MeshDesc wall;
+    wall.points = {Vec3(-5, -5, -2), Vec3(5, -5, -2), Vec3(5, 5, -2), Vec3(-5, 5, -2)};
+    wall.indices = {0, 1, 2, 0, 2, 3};
+    wall.material.albedo = Spectrum(0.3, 0.4, 0.5);
+    MeshDesc glass;
+    for (int i = 0; i < 8; ++i) glass.points.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 0.5 : -0.5));
+    glass.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    glass.material.kind = SurfaceMaterial::Kind::Dielectric;
+    glass.material.ior = 1.5;
+    d.meshes = {wall, glass};
+    d.instances = {{0, Affine()}, {1, Affine()}};
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0), 0.05);
+    RenderSettings s = smallSettings(Kind::PathTracer, 256, 2);
+    s.width = s.height = 2;
+    s.guideAovs = true;
+    Renderer r(std::make_shared<Scene>(d), s);
+    r.render();
+    auto albedo = r.film().resolveRgb(Film::Albedo), normal = r.film().resolveRgb(Film::Normal);
+    double fRed = (albedo[0] - 0.3) / 0.7, fBlue = (albedo[2] - 0.5) / 0.5;
+    EXPECT_GT(fRed, 0.01);
+    EXPECT_LT(fRed, 0.3);
+    EXPECT_NEAR(fRed, fBlue, 1e-5);  // the same mixture in every channel
+    // The wall's normal faces the camera (+z); a reflected ray sees the sky behind the camera, its
+    // normal -ray = -z: the same fraction f again.
+    EXPECT_NEAR(normal[2], 1 - 2 * fRed, 1e-3);
+}
+
 TEST(SpotLitInterval, ContainsEveryPointTheSpotLightsAndLittleMore) {
     // Random lines against a spot of 18 degrees (radius 0 and 0.2): every point on a line that the
     // light reaches (sample() gives radiance) lies inside the line's lit interval, and most points

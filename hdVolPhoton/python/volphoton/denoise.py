@@ -11,8 +11,8 @@ oidnGetDeviceError). ``VOLPHOTON_OIDN=/path/to/libOpenImageDenoise.so`` names an
 library (OIDN 1.x or 2.x: the calls used are in both). Without a library, ``library()`` raises
 DenoiserUnavailable with what to install.
 
-Guides: the albedo and the camera-facing normal at the first vertex of each camera path
-(RenderSettings.guideAovs, core/integrator.h "AOVs"), averaged over the pixel's samples as OIDN's
+Guides: the albedo and the camera-facing normal at the first non-specular vertex of each camera path
+(RenderSettings.guideAovs, core/integrator.h "AOVs": glass is looked through), averaged over the pixel's samples as OIDN's
 "RT" filter expects (noisy guides are allowed). Media report their single-scattering albedo and the
 normal -ray direction, a documented stand-in: OIDN has no volume-specific guide.
 """
