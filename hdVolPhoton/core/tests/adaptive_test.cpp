@@ -356,7 +356,9 @@ TEST(SpotLitInterval, ContainsEveryPointTheSpotLightsAndLittleMore) {
                 auto [s1, s2] = rng.uniform2();
                 bool lit = !spot->sample(ray.at(t), s1, s2).Li.isBlack();
                 bool in = t >= t0 && t <= t1;
-                if (lit) EXPECT_TRUE(in) << "radius " << radius << " line " << line << " t " << t << " [" << t0 << ", " << t1 << "]";
+                if (lit) {
+                    EXPECT_TRUE(in) << "radius " << radius << " line " << line << " t " << t << " [" << t0 << ", " << t1 << "]";
+                }
                 inside += in;
                 litInside += in && lit;
             }
