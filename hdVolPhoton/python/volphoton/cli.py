@@ -564,7 +564,10 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
         for name, image in (("albedo", albedo), ("normal", normal)):
             for i, c in enumerate("RGB"):
                 planes["%s.%s" % (name, c)] = np.ascontiguousarray(image[:, :, i])
-        beauty = denoise.denoise(beauty, albedo, normal)
+        try:
+            beauty = denoise.denoise(beauty, albedo, normal)
+        except (RuntimeError, OSError) as e:
+            raise RenderError("--denoise at %s: %s" % (_when(frame, tc), e))
         for i, c in enumerate("RGB"):
             planes["denoised.%s" % c] = np.ascontiguousarray(beauty[:, :, i])
     exr_path = expand_frame(args.output, frame)
