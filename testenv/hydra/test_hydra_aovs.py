@@ -109,21 +109,8 @@ def test_id_aovs_name_the_prims_the_pixels_see(tmp_path, hydra_env):
         assert d[aov].count(-1) > W * H // 2
 
 
-GUIDE_SCENE = """#usda 1.0
-(
-    upAxis = "Y"
-)
-def Xform "World"
-{
-    def Camera "camera"
-    {
-        float focalLength = 50
-        float horizontalAperture = 20.955
-        float verticalAperture = 10.4775
-        double3 xformOp:translate = (0, 0, 10)
-        uniform token[] xformOpOrder = ["xformOp:translate"]
-    }
-    def Mesh "wall"
+# The id scene's stage header and camera, then one coloured wall and the dome.
+GUIDE_SCENE = SCENE[:SCENE.index('    def Mesh "left"')] + """    def Mesh "wall"
     {
         int[] faceVertexCounts = [4]
         int[] faceVertexIndices = [0, 1, 2, 3]

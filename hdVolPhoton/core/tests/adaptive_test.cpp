@@ -255,10 +255,10 @@ TEST(Adaptive, TimeLimitEndsWithinOnePassAndCapsHold) {
     EXPECT_THROW(Renderer(scene, bad), std::invalid_argument);
 }
 
-TEST(DenoiserGuides, AlbedoAndNormalAtTheFirstVertexAndTheBeautyUnchanged) {
-    // A lambertian wall of albedo (0.3, 0.4, 0.5) facing the camera behind a thin index-matched fog
-    // box of single-scattering albedo 0.8 that covers the left half of the image. Pixels through the
-    // fog average the two first vertices; pixels beside it see the wall only.
+namespace {
+/// A lambertian wall of albedo (0.3, 0.4, 0.5) at z = -2 under a dome of radiance 1, seen from
+/// (0, 0, 3) with tanHalfFov 0.5.
+SceneDesc wallUnderDome() {
     SceneDesc d;
     MeshDesc wall;
     wall.points = {Vec3(-5, -5, -2), Vec3(5, -5, -2), Vec3(5, 5, -2), Vec3(-5, 5, -2)};
@@ -266,11 +266,20 @@ TEST(DenoiserGuides, AlbedoAndNormalAtTheFirstVertexAndTheBeautyUnchanged) {
     wall.material.albedo = Spectrum(0.3, 0.4, 0.5);
     d.meshes.push_back(wall);
     d.instances.push_back({0, Affine()});
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0), 0.5);
+    return d;
+}
+}  // namespace
+
+TEST(DenoiserGuides, AlbedoAndNormalAtTheFirstVertexAndTheBeautyUnchanged) {
+    // A lambertian wall of albedo (0.3, 0.4, 0.5) facing the camera behind a thin index-matched fog
+    // box of single-scattering albedo 0.8 that covers the left half of the image. Pixels through the
+    // fog average the two first vertices; pixels beside it see the wall only.
+    SceneDesc d = wallUnderDome();
     auto c = MediumCoefficients::fromAlbedo(0.5, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeIsotropicPhase());
     d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-5, -5, -1), Vec3(-0.3, 5, 1)}));
     d.unboundedMedia.push_back(0);
-    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
-    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0), 0.5);
     auto scene = std::make_shared<Scene>(d);
     RenderSettings s = smallSettings(Kind::PathTracer, 64, 4);
     s.width = 16;
@@ -308,20 +317,15 @@ TEST(DenoiserGuides, GlassIsLookedThroughToTheFirstNonSpecularVertex) {
     // wall (0.3, 0.4, 0.5), so the centre pixel's albedo is f (1, 1, 1) + (1 - f) (0.3, 0.4, 0.5) with
     // one reflected fraction f in red and blue, a few per cent at near-normal incidence (Fresnel:
     // 4% a face, plus internal reflections). Treating the glass itself as the vertex gives f = 1.
-    SceneDesc d;
-    MeshDesc wall;
-    wall.points = {Vec3(-5, -5, -2), Vec3(5, -5, -2), Vec3(5, 5, -2), Vec3(-5, 5, -2)};
-    wall.indices = {0, 1, 2, 0, 2, 3};
-    wall.material.albedo = Spectrum(0.3, 0.4, 0.5);
+    SceneDesc d = wallUnderDome();
     MeshDesc glass;
     for (int i = 0; i < 8; ++i) glass.points.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 0.5 : -0.5));
     glass.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
     glass.material.kind = SurfaceMaterial::Kind::Dielectric;
     glass.material.ior = 1.5;
-    d.meshes = {wall, glass};
-    d.instances = {{0, Affine()}, {1, Affine()}};
-    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
-    d.camera = lookAt(Vec3(0, 0, 3), Vec3(0, 0, 0), 0.05);
+    d.meshes.push_back(glass);
+    d.instances.push_back({1, Affine()});
+    d.camera.tanHalfFovX = 0.05;
     RenderSettings s = smallSettings(Kind::PathTracer, 256, 2);
     s.width = s.height = 2;
     s.guideAovs = true;
