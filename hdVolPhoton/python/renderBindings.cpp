@@ -7,6 +7,7 @@
 #include "bindings.h"
 #include "core/diagnostics.h"
 #include "core/integrator.h"
+#include "core/translate/settings.h"
 
 namespace py = pybind11;
 
@@ -15,10 +16,6 @@ namespace {
 
 const char* severityName(Severity s) {
     return s == Severity::Error ? "error" : s == Severity::Warning ? "warning" : "info";
-}
-
-const char* integratorName(RenderSettings::Integrator i) {
-    return i == RenderSettings::Integrator::PhotonMap ? "photonMap" : "pathTracer";
 }
 
 py::dict statsToDict(const RenderStats& s) {
@@ -46,7 +43,7 @@ py::dict statsToDict(const RenderStats& s) {
 
 py::dict settingsToDict(const RenderSettings& s) {
     py::dict d;
-    d["integrator"] = integratorName(s.integrator);
+    d["integrator"] = translate::integratorName(s.integrator);
     d["width"] = s.width;
     d["height"] = s.height;
     d["samplesPerPixel"] = s.samplesPerPixel;

@@ -591,7 +591,7 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
     counts = reporter.counts()
     error = rstats["median_relative_error"]
     reporter.info("%s: %dx%d, %d passes (%s), median estimated error %s, %s, %.2f s -> %s%s" % (
-        _when(frame, tc), settings.width, settings.height, rstats["passes"], _STOP_REASONS.get(rstats["stop_reason"], "?"),
+        "frame %d" % frame if frame is not None else "rendered", settings.width, settings.height, rstats["passes"], _STOP_REASONS.get(rstats["stop_reason"], "?"),
         "%.1f%%" % (100 * error) if error >= 0 else "n/a", settings.to_dict()["integrator"],
         t4 - t0, exr_path, (", " + png_path) if png_path else ""))
     if index == 0 and not args.quiet:
