@@ -150,7 +150,7 @@ void Integrator::firstVertexGuides(const Ray& cameraRay, double nearClip, double
     }
 }
 
-Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings)
+Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> photonCache)
     : scene_(std::move(scene)), settings_(settings), film_(settings.width, settings.height) {
     if (settings_.samplesPerPixel < 0) throw std::invalid_argument("render settings: samplesPerPixel must be >= 0");
     if (settings_.maxDepth < 0) throw std::invalid_argument("render settings: maxDepth must be >= 0");
@@ -172,7 +172,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.passesSkipped.push_back("multiple scattering (photons): the scene has no media");
         stats_.passesSkipped.push_back("photon-map camera paths: the scene has no media, so the path tracer renders it");
     }
-    integrator_ = photonMap ? makePhotonMapper(*scene_, settings_) : makePathTracer(*scene_, settings_);
+    integrator_ = photonMap ? makePhotonMapper(*scene_, settings_, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
 }

@@ -31,7 +31,10 @@
 // |                     |        |            |              | Sobol' points over the passes (Rng::stratify);    |
 // |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
-// | photonsPerPass      | int    | 100000     |              | photonMap: photons traced per pass               |
+// | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: 16 per  |
+// |                     |        |            |              | pixel, at least 4096 and at most 1e6              |
+// |                     |        |            |              | (autoPhotonsPerPass), or the count of the photon  |
+// |                     |        |            |              | maps a PhotonCache keeps for the scene            |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the media's diameter, Scene::mediaRadius, else of |
 // |                     |        |            |              | the scene's)                                      |
@@ -77,6 +80,7 @@
 // the sky its radiance clamped to [0, 1] and -ray direction).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -106,7 +110,7 @@ struct RenderSettings {
     int rouletteDepth = 3;
     uint64_t seed = 0;
     int threads = 0;
-    int photonsPerPass = 100000;
+    int photonsPerPass = 0;
     double initialRadius = 0;
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 8;
@@ -131,6 +135,9 @@ struct RenderStats {
     uint64_t photonsStored = 0;
     double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
     double photonRadius = 0;
+    int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic), 0 without photons
+    int photonPassesReused = 0;      ///< photon passes taken from a PhotonCache instead of traced
+    uint64_t photonsReused = 0;      ///< photons in those passes' maps
     double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
     size_t photonMapBytes = 0;
     uint64_t photonsThinned = 0;  ///< photons dropped to stay within photonMapBudgetBytes
@@ -151,6 +158,20 @@ using ProgressCallback = std::function<void(int passDone, int passTotal)>;
 using CancelCallback = std::function<bool()>;
 
 class Integrator;
+class PhotonCache;
+
+/// The automatic photon count (photonsPerPass = 0): PhotonsPerPixel per pixel of the image, at least
+/// one tracing batch and at most MaxAutoPhotons. Photons cost 0.04-2 us each and a camera sample 3-16 us
+/// in the benchmark scenes (tools/bench_photon_cost.py, 2-core VM): an equal split of a pass's time
+/// between the two is 8-99 photons per pixel, 16 sits at the low end of that (most of a pass stays on
+/// the camera side, the dense cloud's photons take about twice its camera time). A fixed count
+/// (the former default, 1e5) made a 4 x 4-pixel check 100x slower with the photon map than with the
+/// path tracer, and a 640 x 360 image spend 2% of its time on photons.
+constexpr int PhotonsPerPixel = 16, MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
+inline int autoPhotonsPerPass(int width, int height) {
+    double n = double(PhotonsPerPixel) * std::max(width, 1) * std::max(height, 1);
+    return static_cast<int>(std::clamp(n, double(MinAutoPhotons), double(MaxAutoPhotons)));
+}
 
 /// \class Renderer
 /// Progressive rendering of a Scene into a Film: each pass adds one sample per pixel (after a photon
@@ -172,7 +193,10 @@ class Integrator;
 /// maxSamplesPerPixel passes.
 class Renderer {
 public:
-    Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings);
+    /// `photonCache`: photon maps kept from earlier renders of the same scene content (PhotonCache;
+    /// the photon-map integrator only), filled by this one; null: none.
+    Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings,
+             std::shared_ptr<PhotonCache> photonCache = nullptr);
     ~Renderer();
     /// Runs one more pass; returns false if cancelled.
     bool renderPass(const CancelCallback& cancel = {});

@@ -178,6 +178,7 @@ protected:
 double fresnelDielectric(double cosI, double eta);
 
 std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings);
-std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings);
+std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
+                                             std::shared_ptr<PhotonCache> cache = nullptr);
 
 }  // namespace volphoton

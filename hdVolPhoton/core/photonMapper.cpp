@@ -27,11 +27,13 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <cstring>
 #include <mutex>
 
 #include "core/diagnostics.h"
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
+#include "core/photonCache.h"
 #include "core/photonMap.h"
 
 namespace volphoton {
@@ -41,7 +43,8 @@ constexpr int PhotonBatch = 4096;
 
 class PhotonMapper final : public Integrator {
 public:
-    PhotonMapper(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
+    PhotonMapper(const Scene& scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache)
+        : Integrator(scene, settings), cache_(std::move(cache)) {
         // Defaults follow the media, not the scene: a fog layer over kilometres of terrain keeps its
         // own kernel and step (the scene's size when a medium is unbounded). Photons from distant
         // and dome lights aim half at the media (PhotonAim).
@@ -75,15 +78,30 @@ public:
         if (!photonsEnabled_) return true;
         double r = radius_;
         for (int i = 0; i < pass; ++i) r *= std::sqrt((i + settings_.radiusAlpha) / (i + 1));
-        std::vector<Photon> photons;
-        uint64_t traced = 0;
-        if (!tracePhotons(pass, settings_.photonsPerPass, &photons, &traced, nullptr, cancel, &stats.photonsThinned)) return false;
-        noteNarrowKernels(photons, r, stats);
-        map_ = std::make_unique<PhotonMap>(std::move(photons), r);
-        stats.photonsTraced += traced;
-        stats.photonsStored += map_->size();
         stats.photonRadius = r;
+        if (cache_) {
+            if (std::shared_ptr<const PhotonCache::Pass> kept = cache_->find(pass)) {
+                map_ = kept->map;
+                stats.photonPassesReused += 1;
+                stats.photonsReused += map_->size();
+                stats.photonsStored += map_->size();
+                stats.photonsRadiusCapped += kept->radiusCapped;
+                stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
+                return true;
+            }
+        }
+        std::vector<Photon> photons;
+        PhotonCache::Pass traced;
+        if (!tracePhotons(pass, photonsPerPass_, &photons, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
+        traced.radiusCapped = noteNarrowKernels(photons, r);
+        traced.map = std::make_shared<const PhotonMap>(std::move(photons), r);
+        map_ = traced.map;
+        stats.photonsTraced += traced.traced;
+        stats.photonsThinned += traced.thinned;
+        stats.photonsRadiusCapped += traced.radiusCapped;
+        stats.photonsStored += map_->size();
         stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
+        if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes, scene_.desc().media);
         return true;
     }
 
@@ -560,13 +578,12 @@ private:
     /// warns once per render when more than a tenth of them are narrowed below r / 100: there the
     /// multiple-scattering estimate is right on average but very noisy (often dark until many passes
     /// have run), so the picture must not look converged silently.
-    void noteNarrowKernels(const std::vector<Photon>& photons, double r, RenderStats& stats) {
+    uint64_t noteNarrowKernels(const std::vector<Photon>& photons, double r) {
         size_t capped = 0, narrow = 0;
         for (const Photon& ph : photons) {
             capped += ph.radius < r;
             narrow += ph.radius < 0.01 * r;
         }
-        stats.photonsRadiusCapped += capped;
         if (!warnedNarrow_ && narrow * 10 > photons.size()) {
             warnedNarrow_ = true;
             warn("photonMap integrator: " + std::to_string(100 * narrow / photons.size()) +
@@ -575,6 +592,7 @@ private:
                  "scattering there stays noisy and dark until many photons have been traced. The path "
                  "tracer handles such optically thick media better.");
         }
+        return capped;
     }
 
     /// Keeps the photon map within the memory budget: exactly `budget` photons survive, chosen
@@ -614,7 +632,7 @@ private:
         if (scene_.hasEmissiveMedia() && emitters_.empty())
             warn("photonMap integrator: the emissive media lie outside the scene's bounds, so their scattered light is not photon-traced");
         if (!settings_.multipleScattering) { stats.passesSkipped.push_back("multiple scattering (photons): disabled by settings"); return; }
-        if (!sourceDist_.size() || settings_.photonsPerPass == 0) { stats.passesSkipped.push_back("multiple scattering (photons): no lights, no emissive media or no photons"); return; }
+        if (!sourceDist_.size()) { stats.passesSkipped.push_back("multiple scattering (photons): no lights and no emissive media"); return; }
         double maxAlbedo = 0;
         for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
         if (maxAlbedo == 0) { stats.passesSkipped.push_back("multiple scattering (photons): every medium has albedo 0"); return; }
@@ -637,6 +655,43 @@ private:
         }
         photonsEnabled_ = true;
         stats.passesRun.push_back("multiple scattering (photons)");
+        photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(settings_.width, settings_.height);
+        if (cache_) {
+            // An automatic count follows the cached maps' (a resized image keeps its photons), unless
+            // those maps are not this scene's: then the count is this image's, as without a cache.
+            int cached = cache_->photonsPerPass();
+            if (settings_.photonsPerPass == 0 && cached > 0 && cache_->use(photonKey(cached, pilot))) {
+                photonsPerPass_ = cached;
+            } else {
+                cache_->use(photonKey(photonsPerPass_, pilot));
+                cache_->setPhotonsPerPass(photonsPerPass_);
+            }
+        }
+        stats.photonsPerPass = photonsPerPass_;
+    }
+
+    /// What the photon passes of this render depend on besides the pass index: the photon settings
+    /// and the pilot photons (PhotonCache): their records change with any light, medium, surface or
+    /// bound they meet.
+    uint64_t photonKey(int photonsPerPass, const std::vector<Photon>& pilot) const {
+        auto bits = [](double x) {
+            uint64_t u;
+            std::memcpy(&u, &x, sizeof u);
+            return u;
+        };
+        uint64_t h = hashKeys(settings_.seed, photonsPerPass, bits(radius_), bits(settings_.radiusAlpha),
+                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonMapBudgetBytes, pilot.size(),
+                              sourceDist_.size(), scene_.lights().size());
+        for (const Photon& ph : pilot) {
+            uint32_t w[11];
+            std::memcpy(w, ph.p, sizeof ph.p);
+            std::memcpy(w + 3, ph.dir, sizeof ph.dir);
+            std::memcpy(w + 6, ph.power, sizeof ph.power);
+            std::memcpy(w + 9, &ph.radius, sizeof(float));
+            w[10] = static_cast<uint32_t>(ph.region);
+            for (uint32_t x : w) h = hashKeys(h, x);
+        }
+        return h;
     }
 
     double radius_, step_;
@@ -648,13 +703,16 @@ private:
     std::vector<Emitter> emitters_;
     Distribution1D sourceDist_;  ///< lights, then emitters_, by power
     bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false;
-    std::unique_ptr<PhotonMap> map_;
+    std::shared_ptr<const PhotonMap> map_;  ///< this pass's map (traced, or kept in cache_)
+    std::shared_ptr<PhotonCache> cache_;
+    int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
 };
 
 }  // namespace
 
-std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings) {
-    return std::make_unique<PhotonMapper>(scene, settings);
+std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
+                                             std::shared_ptr<PhotonCache> cache) {
+    return std::make_unique<PhotonMapper>(scene, settings, std::move(cache));
 }
 
 }  // namespace volphoton

@@ -7,6 +7,7 @@
 #include "bindings.h"
 #include "core/diagnostics.h"
 #include "core/integrator.h"
+#include "core/photonCache.h"
 #include "core/translate/settings.h"
 
 namespace py = pybind11;
@@ -28,6 +29,9 @@ py::dict statsToDict(const RenderStats& s) {
     d["photon_seconds"] = s.photonSeconds;
     d["camera_seconds"] = s.cameraSeconds;
     d["photon_radius"] = s.photonRadius;
+    d["photons_per_pass"] = s.photonsPerPass;
+    d["photon_passes_reused"] = s.photonPassesReused;
+    d["photons_reused"] = s.photonsReused;
     d["multiple_to_single_ratio"] = s.multipleToSingleRatio;
     d["photon_map_bytes"] = s.photonMapBytes;
     d["photons_thinned"] = s.photonsThinned;
@@ -241,12 +245,22 @@ void bindRender(py::module_& m) {
         .def_property_readonly("normal", [](const Film& f) { return imageArray(f.resolveRgb(Film::Normal), f.width(), f.height(), 3); },
                                "denoiser guide (RenderSettings.guide_aovs; zero without it)");
 
+    py::class_<PhotonCache, std::shared_ptr<PhotonCache>>(m, "PhotonCache",
+        "Photon maps kept across renders of one scene content that differ in camera, image size or passes "
+        "(core/photonCache.h). Drop it when lights, media or geometry change.")
+        .def(py::init<>())
+        .def_property_readonly("passes", &PhotonCache::passes, "photon passes kept")
+        .def_property_readonly("bytes", &PhotonCache::bytes)
+        .def_property_readonly("photons_per_pass", &PhotonCache::photonsPerPass)
+        .def("clear", &PhotonCache::clear);
+
     py::class_<Renderer, std::shared_ptr<Renderer>>(m, "Renderer")
-        .def(py::init([](std::shared_ptr<Scene> scene, const RenderSettings& settings) {
+        .def(py::init([](std::shared_ptr<Scene> scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache) {
             if (!scene) throw py::value_error("Renderer: scene is None");
             py::gil_scoped_release release;
-            return std::make_shared<Renderer>(scene, settings);
-        }), py::arg("scene"), py::arg("settings"))
+            return std::make_shared<Renderer>(scene, settings, std::move(cache));
+        }), py::arg("scene"), py::arg("settings"), py::arg("photon_cache") = py::none(),
+           "photon_cache: a PhotonCache shared by renders of one scene content (photon maps reused)")
         .def("render", [](Renderer& r, const py::object& progress, const py::object& cancel) {
             CallbackState state;
             state.progress = callableOrNull(progress, "progress");

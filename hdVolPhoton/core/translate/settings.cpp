@@ -74,8 +74,8 @@ std::vector<SettingInfo> makeTable() {
                  [](RS& s, const AttrValue& v) { s.seed = uint64_t(num(v)); }});
     t.push_back(intSetting("threads", 0, 4096, "--threads", "threadLimit", "Thread limit (0: all cores)", "",
                            "render threads; 0: all cores", &RS::threads));
-    t.push_back(intSetting("photonsPerPass", 0, Big, "--photons", "volphoton:photonsPerPass", "Photons per pass", "",
-                           "photonMap: photons traced per pass", &RS::photonsPerPass));
+    t.push_back(intSetting("photonsPerPass", 0, Big, "--photons", "volphoton:photonsPerPass", "Photons per pass (0: auto)", "",
+                           "photonMap: photons traced per pass (0: 16 per pixel, in [4096, 1e6])", &RS::photonsPerPass));
     t.push_back(doubleSetting("initialRadius", 0, Big, "", "Initial photon radius (0: auto)", "scene units",
                               "photonMap: beam radius of pass 0 (0: 1/100 of the media's diameter)", &RS::initialRadius));
     t.push_back(doubleSetting("radiusAlpha", 1e-6, 1, "", "Photon radius reduction (alpha)", "",

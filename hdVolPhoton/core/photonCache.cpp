@@ -1,0 +1,68 @@
+#include "core/photonCache.h"
+
+#include "core/photonMap.h"
+
+#include <algorithm>
+
+namespace volphoton {
+
+bool PhotonCache::use(uint64_t key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (hasKey_ && key == key_) return true;
+    passes_.clear();
+    bytes_ = 0;
+    photonsPerPass_ = 0;
+    key_ = key;
+    hasKey_ = true;
+    media_.clear();
+    return false;
+}
+
+std::shared_ptr<const PhotonCache::Pass> PhotonCache::find(int pass) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = passes_.find(pass);
+    return it == passes_.end() ? nullptr : it->second;
+}
+
+bool PhotonCache::store(int pass, Pass entry, size_t budgetBytes, const std::vector<MediumPtr>& media) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!entry.map || passes_.count(pass)) return false;
+    size_t b = entry.map->bytes();
+    if (bytes_ + b > budgetBytes) return false;
+    bytes_ += b;
+    passes_[pass] = std::make_shared<const Pass>(std::move(entry));
+    for (const MediumPtr& m : media)
+        if (std::find(media_.begin(), media_.end(), m) == media_.end()) media_.push_back(m);
+    return true;
+}
+
+int PhotonCache::photonsPerPass() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return photonsPerPass_;
+}
+
+void PhotonCache::setPhotonsPerPass(int n) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    photonsPerPass_ = n;
+}
+
+size_t PhotonCache::passes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return passes_.size();
+}
+
+size_t PhotonCache::bytes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return bytes_;
+}
+
+void PhotonCache::clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    passes_.clear();
+    media_.clear();
+    bytes_ = 0;
+    photonsPerPass_ = 0;
+    hasKey_ = false;
+}
+
+}  // namespace volphoton

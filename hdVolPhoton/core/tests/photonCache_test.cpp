@@ -1,0 +1,167 @@
+// Photon maps reused across renders (core/photonCache.h) and the automatic photon count.
+#include <gtest/gtest.h>
+
+#include "core/homogeneousMedium.h"
+#include "core/photonCache.h"
+#include "tests/renderTestUtil.h"
+
+namespace volphoton {
+namespace {
+
+using test::lookAt;
+
+/// A fog box lit by a sphere light at `light` and a distant light, seen from `eye`.
+SceneDesc fogScene(const Vec3& light, const Vec3& eye = Vec3(0.2, 0.3, 3.5)) {
+    SceneDesc d;
+    auto c = MediumCoefficients::fromAlbedo(1.5, Spectrum(1.0, 0.8, 0.6), Spectrum(0.9, 0.8, 0.7), Spectrum(0.0),
+                                            makeHenyeyGreensteinPhase(0.3));
+    d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
+    d.unboundedMedia.push_back(0);
+    d.lights.push_back(makeDistantLight(normalize(Vec3(0.3, -1, 0.2)), 0.0, Spectrum(2.0)));
+    d.lights.push_back(makeSphereLight(light, 0.1, Spectrum(1.0)));
+    d.camera = lookAt(eye, Vec3(0, 0, 0), 0.4);
+    return d;
+}
+
+RenderSettings pmSettings(int spp) {
+    RenderSettings s = test::smallSettings(RenderSettings::Integrator::PhotonMap, spp, 7);
+    s.photonsPerPass = 3000;
+    return s;
+}
+
+using RendererPtr = std::unique_ptr<Renderer>;
+std::vector<float> beauty(const RendererPtr& r) { return r->film().resolveRgb(Film::Beauty); }
+
+RendererPtr rendered(const SceneDesc& d, const RenderSettings& s, std::shared_ptr<PhotonCache> cache = nullptr) {
+    auto r = std::make_unique<Renderer>(std::make_shared<Scene>(d), s, std::move(cache));
+    r->render();
+    return r;
+}
+
+}  // namespace
+
+TEST(PhotonCache, ACameraMoveReusesEveryPassAndMatchesAFreshRender) {
+    auto cache = std::make_shared<PhotonCache>();
+    RenderSettings s = pmSettings(4);
+    RendererPtr first = rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+    EXPECT_EQ(first->stats().photonPassesReused, 0);
+    EXPECT_EQ(first->stats().photonsTraced, 4u * 3000);
+    EXPECT_EQ(cache->passes(), 4u);
+    EXPECT_EQ(cache->photonsPerPass(), 3000);
+    // The same lights and media from elsewhere, in a scene built anew (as each front end does).
+    SceneDesc moved = fogScene(Vec3(1.5, 0.5, 0.5), Vec3(-2.5, 1.0, 2.5));
+    RendererPtr reused = rendered(moved, s, cache);
+    RendererPtr fresh = rendered(moved, s);
+    EXPECT_EQ(reused->stats().photonPassesReused, 4);
+    EXPECT_EQ(reused->stats().photonsTraced, 0u);
+    EXPECT_EQ(reused->stats().photonsReused, fresh->stats().photonsStored);
+    EXPECT_EQ(beauty(reused), beauty(fresh));  // bit-identical: a reused pass is the pass it would trace
+    EXPECT_NE(beauty(reused), beauty(first));  // (the camera did move)
+}
+
+TEST(PhotonCache, MovingALightInvalidatesAndRendersAsAFreshRender) {
+    auto cache = std::make_shared<PhotonCache>();
+    RenderSettings s = pmSettings(3);
+    rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+    SceneDesc lightMoved = fogScene(Vec3(1.5, 0.5, 0.45));  // 5 cm: the pilot photons see it
+    RendererPtr withCache = rendered(lightMoved, s, cache);
+    RendererPtr fresh = rendered(lightMoved, s);
+    EXPECT_EQ(withCache->stats().photonPassesReused, 0);
+    EXPECT_EQ(withCache->stats().photonsTraced, fresh->stats().photonsTraced);
+    EXPECT_EQ(beauty(withCache), beauty(fresh));
+    EXPECT_EQ(cache->passes(), 3u);  // now the moved light's maps
+}
+
+TEST(PhotonCache, ChangedPhotonSettingsInvalidate) {
+    RenderSettings s = pmSettings(2);
+    SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
+    auto change = [&](const std::function<void(RenderSettings&)>& edit) {
+        auto cache = std::make_shared<PhotonCache>();
+        rendered(d, s, cache);
+        RenderSettings t = s;
+        edit(t);
+        RendererPtr again = rendered(d, t, cache);
+        EXPECT_EQ(again->stats().photonPassesReused, 0);
+        EXPECT_EQ(beauty(again), beauty(rendered(d, t)));
+    };
+    change([](RenderSettings& t) { t.seed = 8; });
+    change([](RenderSettings& t) { t.photonsPerPass = 2000; });
+    change([](RenderSettings& t) { t.initialRadius = 0.07; });
+    change([](RenderSettings& t) { t.radiusAlpha = 0.5; });
+    change([](RenderSettings& t) { t.photonRadiusMfp = 2; });
+}
+
+TEST(PhotonCache, MorePassesThanCachedTraceTheRestAndTheBudgetBoundsTheCache) {
+    SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
+    auto cache = std::make_shared<PhotonCache>();
+    RenderSettings s = pmSettings(2);
+    rendered(d, s, cache);
+    s.samplesPerPixel = 5;
+    RendererPtr more = rendered(d, s, cache);
+    EXPECT_EQ(more->stats().photonPassesReused, 2);
+    EXPECT_EQ(more->stats().photonsTraced, 3u * 3000);
+    EXPECT_EQ(beauty(more), beauty(rendered(d, s)));
+    EXPECT_EQ(cache->passes(), 5u);
+
+    // A budget of about two maps keeps two passes; the rest are traced each time.
+    auto small = std::make_shared<PhotonCache>();
+    RenderSettings b = pmSettings(4);
+    RendererPtr probe = rendered(d, b);
+    b.photonMapBudgetBytes = probe->stats().photonMapBytes * 2 + probe->stats().photonMapBytes / 2;
+    RendererPtr r1 = rendered(d, b, small);
+    EXPECT_EQ(small->passes(), 2u);
+    EXPECT_LE(small->bytes(), b.photonMapBudgetBytes);
+    RendererPtr r2 = rendered(d, b, small);
+    EXPECT_EQ(r2->stats().photonPassesReused, 2);
+    EXPECT_EQ(beauty(r1), beauty(r2));
+}
+
+TEST(PhotonCache, ThePathTracerAndPhotonFreeScenesLeaveItEmpty) {
+    auto cache = std::make_shared<PhotonCache>();
+    RenderSettings s = pmSettings(2);
+    s.integrator = RenderSettings::Integrator::PathTracer;
+    rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+    EXPECT_EQ(cache->passes(), 0u);
+    s.integrator = RenderSettings::Integrator::PhotonMap;
+    s.multipleScattering = false;
+    RendererPtr r = rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+    EXPECT_EQ(cache->passes(), 0u);
+    EXPECT_EQ(r->stats().photonsPerPass, 0);
+}
+
+TEST(PhotonCount, AutomaticCountFollowsThePixelCountWithinItsBounds) {
+    EXPECT_EQ(autoPhotonsPerPass(4, 4), MinAutoPhotons);
+    EXPECT_EQ(autoPhotonsPerPass(100, 50), 16 * 5000);
+    EXPECT_EQ(autoPhotonsPerPass(1920, 1080), MaxAutoPhotons);
+    SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
+    RenderSettings s = pmSettings(1);
+    s.photonsPerPass = 0;  // the default
+    EXPECT_EQ(RenderSettings().photonsPerPass, 0);
+    for (auto [w, h] : {std::pair{4, 4}, std::pair{40, 30}}) {
+        s.width = w;
+        s.height = h;
+        RendererPtr r = rendered(d, s);
+        EXPECT_EQ(r->stats().photonsPerPass, autoPhotonsPerPass(w, h));
+        EXPECT_EQ(r->stats().photonsTraced, static_cast<uint64_t>(autoPhotonsPerPass(w, h)));
+    }
+}
+
+TEST(PhotonCount, AResizedImageKeepsTheCachedAutomaticCount) {
+    SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
+    RenderSettings s = pmSettings(2);
+    s.photonsPerPass = 0;
+    s.width = s.height = 20;  // 6400 photons
+    auto cache = std::make_shared<PhotonCache>();
+    rendered(d, s, cache);
+    s.width = s.height = 30;  // would be 14400
+    RendererPtr resized = rendered(d, s, cache);
+    EXPECT_EQ(resized->stats().photonsPerPass, autoPhotonsPerPass(20, 20));
+    EXPECT_EQ(resized->stats().photonPassesReused, 2);
+    // Another scene in the same cache: the count is this image's again.
+    RendererPtr other = rendered(fogScene(Vec3(1.2, 0.5, 0.5)), s, cache);
+    EXPECT_EQ(other->stats().photonsPerPass, autoPhotonsPerPass(30, 30));
+    EXPECT_EQ(other->stats().photonPassesReused, 0);
+    EXPECT_EQ(beauty(other), beauty(rendered(fogScene(Vec3(1.2, 0.5, 0.5)), s)));
+}
+
+}  // namespace volphoton
