@@ -816,6 +816,71 @@ def test_frames_render_each_time_code(tmp_path):
     assert r.returncode == 2 and "placeholder" in r.stderr and "Traceback" not in r.stderr
 
 
+FOG_SHOT = """
+    def Cube "fog" (prepend apiSchemas = ["VolPhotonMediumAPI"]) {
+        double size = 2
+        float volphoton:density = 1.5
+        color3f volphoton:albedo = (0.9, 0.8, 0.7)
+        rel material:binding = </Fog>
+    }
+    def Material "Fog" {}
+    def SphereLight "lamp" {
+        float inputs:radius = 0.1
+        float inputs:intensity = 40
+        double3 xformOp:translate%(light)s
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+    def Xform "rig" {
+        double3 xformOp:translate.timeSamples = {1: (0, 0, 0), 2: (0.4, 0.2, 0), 3: (-0.3, 0.1, 0.2)}
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+        def Camera "cam" {
+            double3 xformOp:translate = (0.2, 0.3, 4)
+            uniform token[] xformOpOrder = ["xformOp:translate"]
+        }
+    }
+"""
+
+
+def _render_frames(tmp_path, name, light, frames):
+    _, path = stage_from(tmp_path, FOG_SHOT % {"light": light}, name=name + ".usda")
+    out = tmp_path / name
+    r = run_cli("render", path, "-o", out / "f.####.exr", "--frames", frames, "--resolution", "12", "12",
+                "--spp", "3", "--integrator", "photonmap", "--camera", "/rig/cam", "--photons", "3000",
+                "--stats", out / "stats.json")
+    assert r.returncode == 0, r.stderr
+    stats = json.loads((out / "stats.json").read_text())
+    images = {fr["frame"]: output.read_exr(fr["output"]["exr"])[0]["R"] for fr in stats["frames"]}
+    return r, {fr["frame"]: fr["render"] for fr in stats["frames"]}, images
+
+
+def test_frames_with_only_the_camera_animated_trace_photons_once(tmp_path):
+    """--frames over a shot where only the camera moves: frames after the first reuse every photon
+    pass (core PhotonCache) and are bit-identical to frames rendered on their own; an animated light
+    makes every frame trace its photons, and says why."""
+    r, shot, images = _render_frames(tmp_path, "shot", " = (1.5, 0.5, 0.5)", "1:3")
+    assert shot[1]["photons_traced"] == 3 * 3000 and shot[1]["photon_passes_reused"] == 0
+    for f in (2, 3):
+        assert shot[f]["photons_traced"] == 0 and shot[f]["photon_passes_reused"] == 3, shot[f]
+        assert shot[f]["photons_reused"] == shot[1]["photons_stored"]
+    assert "photon maps of 3 passes reused" in r.stderr
+    _, alone, alone_images = _render_frames(tmp_path, "alone", " = (1.5, 0.5, 0.5)", "3")
+    assert alone[3]["photons_traced"] == 3 * 3000
+    assert np.array_equal(images[3], alone_images[3])
+    assert not np.array_equal(images[2], images[3])  # the camera did move
+
+    r, lit, _ = _render_frames(tmp_path, "lit", ".timeSamples = {1: (1.5, 0.5, 0.5), 3: (1.5, -0.5, 0.5)}", "1:2")
+    assert all(lit[f]["photons_traced"] == 3 * 3000 and lit[f]["photon_passes_reused"] == 0 for f in (1, 2))
+    assert "/lamp.xformOp:translate may vary in time" in r.stderr
+
+
+def test_only_camera_animation_is_static_content(tmp_path):
+    stage, _ = stage_from(tmp_path, FOG_SHOT % {"light": " = (1, 1, 1)"})
+    assert usdscene.first_time_varying_content(stage) is None
+    # the rig's transform above the camera and geometry: content moves
+    stage.DefinePrim("/rig/prop", "Sphere")
+    assert usdscene.first_time_varying_content(stage) == "/rig.xformOp:translate"
+
+
 def one_line_error(r):
     """The command failed with a one-line message and no traceback."""
     assert "Traceback" not in r.stderr, r.stderr

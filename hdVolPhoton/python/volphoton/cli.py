@@ -499,10 +499,11 @@ def cmd_render(args) -> int:
             reporter.diagnostic(d)
         setup_errors = sum(d.severity == "error" for d in rs_info.diagnostics)
         total_errors += setup_errors
+        photon_cache = _photon_cache(core, usdscene, stage, settings, frames, reporter, args.quiet)
         for index, (frame, tc) in enumerate(frames):
             reporter.new_frame()
             fstats = _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path,
-                                   rs_info, display, progress, reporter, index, len(frames))
+                                   rs_info, display, progress, reporter, index, len(frames), photon_cache)
             total_errors += fstats["diagnostics"]["errors"]
             run_stats["frames"].append(fstats)
             if args.stats and stats_per_frame:
@@ -523,8 +524,23 @@ def cmd_render(args) -> int:
         core.set_diagnostic_sink(None)
 
 
+def _photon_cache(core, usdscene, stage, settings, frames, reporter, quiet):
+    """One PhotonCache for the whole frame range when photons can be reused: the photon map integrator,
+    several frames, and nothing but cameras animated (usdscene.first_time_varying_content). Reused
+    passes are bit-identical to traced ones, so every frame is the image it would be on its own."""
+    if len(frames) < 2 or settings.to_dict()["integrator"] != "photonMap":
+        return None
+    varying = usdscene.first_time_varying_content(stage)
+    if varying:
+        if not quiet:
+            reporter.info("photons are traced for every frame: %s may vary in time (only camera animation "
+                          "keeps the photon maps from frame to frame)" % varying)
+        return None
+    return core.PhotonCache()
+
+
 def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, camera_path, rs_info, display,
-                  progress, reporter, index, count) -> dict:
+                  progress, reporter, index, count, photon_cache=None) -> dict:
     t0 = _time.perf_counter()
     cap = settings.max_grid_voxels
     scene = usdscene.translate(stage, tc, settings.width, settings.height, camera_path, rs_info.conform_policy, cap)
@@ -535,7 +551,7 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
         raise RenderError("nothing to render at %s: the stage has no geometry, media or lights" % _when(frame, tc))
     try:
         core_scene = core.Scene(scene.desc)
-        renderer = core.Renderer(core_scene, settings)
+        renderer = core.Renderer(core_scene, settings, photon_cache)
     except (ValueError, RuntimeError) as e:
         raise RenderError("cannot build the scene at %s: %s" % (_when(frame, tc), e))
     t2 = _time.perf_counter()
@@ -590,9 +606,11 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
     t4 = _time.perf_counter()
     counts = reporter.counts()
     error = rstats["median_relative_error"]
-    reporter.info("%s: %dx%d, %d passes (%s), median estimated error %s, %s, %.2f s -> %s%s" % (
+    reused = rstats["photon_passes_reused"]
+    reporter.info("%s: %dx%d, %d passes (%s), median estimated error %s, %s%s, %.2f s -> %s%s" % (
         "frame %d" % frame if frame is not None else "rendered", settings.width, settings.height, rstats["passes"], _STOP_REASONS.get(rstats["stop_reason"], "?"),
         "%.1f%%" % (100 * error) if error >= 0 else "n/a", settings.to_dict()["integrator"],
+        " (photon maps of %d pass%s reused)" % (reused, "" if reused == 1 else "es") if reused else "",
         t4 - t0, exr_path, (", " + png_path) if png_path else ""))
     if index == 0 and not args.quiet:
         reporter.info("EXR layers: R,G,B,A beauty; single, multiple, emission, surface (the light-path split); "
@@ -614,6 +632,9 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "camera_samples": rstats["camera_samples"],
             "samples_per_pixel": rstats["passes"],
             "photons_traced": rstats["photons_traced"],
+            "photons_per_pass": rstats["photons_per_pass"],
+            "photon_passes_reused": rstats["photon_passes_reused"],
+            "photons_reused": rstats["photons_reused"],
             "photons_stored": rstats["photons_stored"],
             "photon_seconds": rstats["photon_seconds"],
             "camera_seconds": rstats["camera_seconds"],

@@ -1118,6 +1118,33 @@ def _camera(prim: Usd.Prim, time, xf: UsdGeom.XformCache, width: int, height: in
     return CameraRecord(str(path), desc, projection, params)
 
 
+_CAMERA_RIG_TYPES = ("Camera", "Xform", "Scope", "")
+
+
+def first_time_varying_content(stage: Usd.Stage) -> Optional[str]:
+    """The first attribute (``/prim.attr``) that may vary in time and reaches more than cameras, or None
+    when only cameras (and transforms above nothing but cameras) can change from frame to frame.
+
+    Photons do not see the camera, so a --frames range over such a stage keeps one PhotonCache: every
+    frame after the first reuses the photon maps (core/photonCache.h). Any other animated attribute
+    (a light, a medium, a mesh, a material, a transform above them, an asset path, a render setting)
+    makes each frame trace its own photons."""
+    rig_only = {}
+
+    def only_cameras_below(prim: Usd.Prim) -> bool:
+        path = prim.GetPath()
+        if path not in rig_only:
+            rig_only[path] = all(p.GetTypeName() in _CAMERA_RIG_TYPES
+                                 for p in Usd.PrimRange(prim, Usd.TraverseInstanceProxies()))
+        return rig_only[path]
+
+    for prim in stage.Traverse(Usd.TraverseInstanceProxies()):
+        for attr in prim.GetAttributes():
+            if attr.ValueMightBeTimeVarying() and not only_cameras_below(prim):
+                return "%s.%s" % (prim.GetPath(), attr.GetName())
+    return None
+
+
 def translate(stage: Usd.Stage, time=Usd.TimeCode.Default(), width: int = 640, height: int = 360,
               camera_path: Optional[str] = None, conform_policy: str = "expandAperture",
               max_grid_voxels: Optional[int] = None) -> TranslatedScene:
