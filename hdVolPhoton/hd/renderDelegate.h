@@ -25,7 +25,7 @@ class HdVolPhotonRenderParam;
 /// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
 /// | volphoton:maxDepth           | int   | 100000     | events per path (safety cap; lower: biased)  |
-/// | volphoton:photonsPerPass     | int   | 100000     | photonMap: photons per pass                  |
+/// | volphoton:photonsPerPass     | int   | 0 (auto)   | photonMap: photons per pass (auto: 16/pixel) |
 /// | volphoton:initialRadius      | float | 0 (auto)   | photonMap: beam radius of pass 0             |
 /// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |
 /// | volphoton:multipleScattering | bool  | true       | photonMap: photon pass on/off                |

@@ -52,6 +52,8 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
         return;
 
     _renderThread->StopRender();
+    // Photons see neither the camera nor the image: a restart for those keeps the photon maps.
+    bool const keepPhotons = _started && version == _lastSceneVersion && settingsVersion == _lastSettingsVersion;
     _lastSceneVersion = version;
     _lastSettingsVersion = settingsVersion;
     _viewMatrix = view;
@@ -100,7 +102,7 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
                 buffer->Allocate(GfVec3i(width, height, 1), buffer->GetFormat(), false);
             buffer->SetConverged(false);
         }
-    _renderer->SetScene(scene, settings, proj, aovs, _delegate->IsInteractive());
+    _renderer->SetScene(scene, settings, proj, aovs, _delegate->IsInteractive(), keepPhotons);
     _renderThread->StartRender();
     _started = true;
 }

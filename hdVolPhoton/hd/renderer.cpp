@@ -6,6 +6,7 @@
 #include "pxr/base/vt/types.h"
 #include "pxr/imaging/hd/tokens.h"
 
+#include "core/photonCache.h"
 #include "hd/renderBuffer.h"
 
 #include <algorithm>
@@ -19,8 +20,9 @@ using namespace volphoton;
 
 void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSettings const &settings,
                                     GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings,
-                                    bool interactive) {
+                                    bool interactive, bool keepPhotons) {
     _scene = std::move(scene);
+    if (!keepPhotons || !_photonCache) _photonCache = std::make_shared<PhotonCache>();
     _settings = settings;
     _projection = projection;
     _aovBindings = aovBindings;
@@ -47,6 +49,9 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["photonsTraced"] = VtValue(static_cast<uint64_t>(_stats.photonsTraced));
     d["photonsStored"] = VtValue(static_cast<uint64_t>(_stats.photonsStored));
     d["photonRadius"] = VtValue(_stats.photonRadius);
+    d["photonsPerPass"] = VtValue(_stats.photonsPerPass);
+    d["photonPassesReused"] = VtValue(_stats.photonPassesReused);
+    d["photonsReused"] = VtValue(static_cast<uint64_t>(_stats.photonsReused));
     d["totalSeconds"] = VtValue(_stats.seconds);
     d["photonSeconds"] = VtValue(_stats.photonSeconds);
     d["cameraSeconds"] = VtValue(_stats.cameraSeconds);
@@ -66,7 +71,7 @@ void HdVolPhoton_Renderer::Render(HdRenderThread *thread) {
     if (!_scene) return;
     std::unique_ptr<Renderer> renderer;
     try {
-        renderer = std::make_unique<Renderer>(_scene, _settings);
+        renderer = std::make_unique<Renderer>(_scene, _settings, _photonCache);
     } catch (std::exception const &e) {
         TF_WARN("hdVolPhoton: cannot render: %s", e.what());
         return;

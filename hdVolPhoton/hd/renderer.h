@@ -39,11 +39,17 @@ PXR_NAMESPACE_OPEN_SCOPE
 /// full pass overwrites it and the converged image is the same as without it (usdrecord's final
 /// image never shows it). Stats: framesWritten counts buffer updates since the restart, previewBlock
 /// is the block of the preview shown (0: none). HDVOLPHOTON_PREVIEW=0 (debug knob) turns previews off.
+///
+/// Photon maps (the photon-map integrator) survive restarts that change only what photons do not see:
+/// the camera, the image size, the AOVs (SetScene's keepPhotons). One volphoton::PhotonCache is kept
+/// until the scene or the render settings change; each restart's photon passes are taken from it
+/// while it has them (bit-identical to tracing them again). Stats: photonPassesReused, photonsReused.
 class HdVolPhoton_Renderer
 {
 public:
     void SetScene(std::shared_ptr<volphoton::Scene const> scene, volphoton::RenderSettings const &settings,
-                  GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings, bool interactive);
+                  GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings, bool interactive,
+                  bool keepPhotons);
     void Render(HdRenderThread *renderThread);
     bool IsConverged() const;
     VtDictionary GetStats() const;
@@ -57,6 +63,7 @@ private:
     int _PreviewBlock() const;
 
     std::shared_ptr<volphoton::Scene const> _scene;
+    std::shared_ptr<volphoton::PhotonCache> _photonCache;  ///< photon maps of the scene content
     volphoton::RenderSettings _settings;
     GfMatrix4d _projection{1.0};
     HdRenderPassAovBindingVector _aovBindings;

@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 """Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): interactive
 refinement past samplesPerPixel, batch convergence, pause, resume, stop, restart on a camera change,
-when the coarse preview is shown, and the integrator setting as usdview's dialog sets it. Run by
+when the coarse preview is shown, the integrator setting as usdview's dialog sets it, and photon maps
+kept across camera moves and resizes but not a moved light. Run by
 test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
 PXR_PLUGINPATH_NAME:
 
-    python3 engine_lifecycle.py SCENE.usda CAMERA_PATH
+    python3 engine_lifecycle.py SCENE.usda CAMERA_PATH LIGHT_PATH
 
 Exits 0 when every check holds; otherwise prints the failed check and exits 1. About 5 s.
 """
@@ -25,7 +26,7 @@ def check(condition, what):
         sys.exit(1)
 
 
-def main(scene, camera_path):
+def main(scene, camera_path, light_path):
     stage = Usd.Stage.Open(scene)
     params = UsdImagingGL.Engine.Parameters()
     params.gpuEnabled = False
@@ -126,6 +127,32 @@ def main(scene, camera_path):
         engine.SetRendererSetting("volphoton:integrator", value)  # a Python str: a std::string, as the dialog sets it
         render_until(lambda: passes() >= 1)
         check((stats()["photonsTraced"] > 0) == photons, "%s: photonsTraced %s" % (value, stats()["photonsTraced"]))
+
+    # Photon maps survive restarts for what photons do not see (camera, image size), not a light move.
+    engine.SetRendererSetting("volphoton:integrator", "photonMap")
+    engine.SetRendererSetting("convergedSamplesPerPixel", 3)
+    engine.SetRendererSetting("volphoton:photonsPerPass", 2000)
+
+    def converged_stats():
+        render_until(lambda: passes() > 0 and engine.IsConverged())
+        return stats()
+
+    s = converged_stats()
+    check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "photons traced first: %s" % s)
+    f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), -2.0)))
+    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    s = converged_stats()
+    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3 and s["photonsReused"] > 0,
+          "a camera move reuses every photon pass: %s" % s)
+    size = (48, 27)
+    engine.SetRenderBufferSize(Gf.Vec2i(*size))
+    engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), size[0], size[1])))
+    s = converged_stats()
+    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3, "a resize reuses every photon pass: %s" % s)
+    light = UsdGeom.Xformable(stage.GetPrimAtPath(light_path))
+    light.GetOrderedXformOps()[0].Set(Gf.Vec3d(0.3, 3.9, 0.5))
+    s = converged_stats()
+    check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "a moved light traces photons: %s" % s)
     engine.StopRenderer()
     print("OK")
     return 0
