@@ -2,13 +2,17 @@
 """What a photon and a camera sample cost in the photon-map integrator (issue 15, "photon counts
 that fit the job"): for each benchmark scene (testenv/bench/*.usda) at its settings, 4 passes at
 defaults, the photon pass's ns per traced photon, the camera pass's ns per pixel-sample, and the
-photons per pixel that would make the two passes take equally long.
+photons per pixel that would make the two passes take equally long; then the counted work
+(core/workCount.h: rays and medium lookups of a camera pass and of a photon, from the pilots) and
+the balance the automatic photon count derives from it with RayCost, against the measured balance,
+and the RayCost that fits the measured balances best (least squares of the log ratio).
 
     python tools/bench_photon_cost.py                 # 80x60
     python tools/bench_photon_cost.py --resolution 160 120 --passes 8
 """
 
 import argparse
+import math
 import os
 
 from pxr import Usd
@@ -28,8 +32,10 @@ def main(argv=None):
     vdb = os.path.join(BENCH, "cloud.vdb")
     if not os.path.exists(vdb):
         _core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)  # the benchmark's cloud
-    print("| scene | ns per photon | ns per camera pixel-sample | photons per pixel for equal pass times |")
-    print("|---|---|---|---|")
+    print("| scene | ns per photon | ns per camera pixel-sample | photons per pixel for equal pass times "
+          "| camera pass rays, lookups per pixel | photon rays, lookups | modelled photons per pixel | model / measured |")
+    print("|---|---|---|---|---|---|---|---|")
+    rows = []
     for name in SCENES:
         stage = Usd.Stage.Open(os.path.join(BENCH, name + ".usda"))
         rs = usdscene.read_render_settings(stage)
@@ -40,8 +46,23 @@ def main(argv=None):
         stats = _core.Renderer(_core.Scene(tr.desc), s).render()
         photon = stats["photon_seconds"] / max(stats["photons_traced"], 1) * 1e9
         camera = stats["camera_seconds"] / (w * h * args.passes) * 1e9
-        print("| %s | %.0f | %.0f | %.0f |" % (name, photon, camera, camera / photon if photon > 0 else float("nan")),
-              flush=True)
+        measured = camera / photon if photon > 0 else float("nan")
+        cw, pw = stats["camera_pass_work"], stats["photon_work"]
+        modelled = stats["photon_work_ratio"] / (w * h)
+        rows.append((measured, cw, pw))
+        print("| %s | %.0f | %.0f | %.1f | %.2f, %.1f | %.2f, %.1f | %.1f | %.2f |" % (
+            name, photon, camera, measured, cw["rays"] / (w * h), cw["lookups"] / (w * h), pw["rays"], pw["lookups"],
+            modelled, modelled / measured), flush=True)
+    best = None
+    for ray_cost in [x * 0.5 for x in range(1, 201)]:
+        for lookup_cost in [x * 0.1 for x in range(5, 60)]:
+            err = sum(math.log((cw["rays"] * ray_cost + cw["lookups"]) /
+                               (pw["rays"] * ray_cost + pw["lookups"] * lookup_cost) / (w * h) / m) ** 2
+                      for m, cw, pw in rows if m > 0 and pw["rays"] + pw["lookups"] > 0)
+            if best is None or err < best[2]:
+                best = (ray_cost, lookup_cost, err)
+    print("\nfit to the measured balances (core/workCount.h): RayCost %.1f, PhotonLookupCost %.1f (rms log error %.2f)"
+          % (best[0], best[1], math.sqrt(best[2] / len(rows))))
 
 
 if __name__ == "__main__":

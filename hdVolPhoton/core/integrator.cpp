@@ -9,6 +9,7 @@
 #include "core/diagnostics.h"
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
+#include "core/workCount.h"
 
 namespace volphoton {
 
@@ -172,6 +173,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.passesSkipped.push_back("multiple scattering (photons): the scene has no media");
         stats_.passesSkipped.push_back("photon-map camera paths: the scene has no media, so the path tracer renders it");
     }
+    usesPhotons_ = photonMap;
     integrator_ = photonMap ? makePhotonMapper(*scene_, settings_, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
@@ -205,9 +207,27 @@ bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int
 
 }  // namespace
 
+work::Count Renderer::cameraPilotWork() const {
+    const int w = settings_.width, h = settings_.height;
+    const uint64_t pixels = uint64_t(w) * h;
+    const int n = static_cast<int>(std::min<uint64_t>(256, pixels));
+    Camera camera(scene_->desc().camera, w, h);
+    work::Snapshot before = work::snapshot();
+    for (int k = 0; k < n; ++k) {
+        uint64_t i = k * pixels / n;  // spread over the image
+        Rng rng(hashKeys(0x50494c4fULL, settings_.seed, k));
+        PathRadiance L;
+        cameraSample(*integrator_, camera, static_cast<int>(i % w), static_cast<int>(i / w), rng, &L);
+    }
+    return work::since(before) * (double(pixels) / n);
+}
+
 bool Renderer::renderPass(const CancelCallback& cancel) {
     auto start = std::chrono::steady_clock::now();
     auto threads = limitThreads(settings_);
+    // The photon map's automatic photon count weighs a camera pass's work (deterministic pilot, on
+    // this thread: work is counted per thread) against a photon's.
+    if (pass_ == 0 && usesPhotons_ && settings_.photonsPerPass == 0) integrator_->setCameraWork(cameraPilotWork());
     if (!integrator_->beginPass(pass_, stats_, cancel)) {
         stats_.cancelled = true;
         return false;

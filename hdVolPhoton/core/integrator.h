@@ -31,14 +31,15 @@
 // |                     |        |            |              | Sobol' points over the passes (Rng::stratify);    |
 // |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
-// | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: 16 per  |
-// |                     |        |            |              | pixel, at least 4096 and at most 1e6              |
-// |                     |        |            |              | (autoPhotonsPerPass), or the count of the photon  |
-// |                     |        |            |              | maps a PhotonCache keeps for the scene            |
+// | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: as many |
+// |                     |        |            |              | as cost two camera passes (pilots count work, not |
+// |                     |        |            |              | time), in [4096, 1e6] (autoPhotonsPerPass), or the|
+// |                     |        |            |              | count of the maps a PhotonCache keeps             |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the media's diameter, Scene::mediaRadius, else of |
 // |                     |        |            |              | the scene's)                                      |
-// | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1)      |
+// | radiusAlpha         | double | 0.7        |              | photonMap: r_{i+1}^2 = r_i^2 (i+alpha)/(i+1), i   |
+// |                     |        |            |              | counting 1e5 photons traced (passRadius)          |
 // | photonRadiusMfp     | double | 8          | mean free    | photonMap: a photon's radius is at most this many |
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
@@ -90,6 +91,7 @@
 #include "core/film.h"
 #include "core/scene.h"
 #include "core/transmittance.h"
+#include "core/workCount.h"
 
 namespace volphoton {
 
@@ -136,6 +138,8 @@ struct RenderStats {
     double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
     double photonRadius = 0;
     int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic), 0 without photons
+    double photonWorkRatio = 0;      ///< photonMap: photons costing as much as a camera pass (pilots; 0: not measured)
+    work::Count cameraWork, photonWork;  ///< photonMap pilots: rays and lookups of a camera pass, of a photon
     int photonPassesReused = 0;      ///< photon passes taken from a PhotonCache instead of traced
     uint64_t photonsReused = 0;      ///< photons in those passes' maps
     double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
@@ -160,17 +164,23 @@ using CancelCallback = std::function<bool()>;
 class Integrator;
 class PhotonCache;
 
-/// The automatic photon count (photonsPerPass = 0): PhotonsPerPixel per pixel of the image, at least
-/// one tracing batch and at most MaxAutoPhotons. Photons cost 0.04-2 us each and a camera sample 3-16 us
-/// in the benchmark scenes (tools/bench_photon_cost.py, 2-core VM): an equal split of a pass's time
-/// between the two is 8-99 photons per pixel, 16 sits at the low end of that (most of a pass stays on
-/// the camera side, the dense cloud's photons take about twice its camera time). A fixed count
-/// (the former default, 1e5) made a 4 x 4-pixel check 100x slower with the photon map than with the
-/// path tracer, and a 640 x 360 image spend 2% of its time on photons.
-constexpr int PhotonsPerPixel = 16, MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
-inline int autoPhotonsPerPass(int width, int height) {
-    double n = double(PhotonsPerPixel) * std::max(width, 1) * std::max(height, 1);
-    return static_cast<int>(std::clamp(n, double(MinAutoPhotons), double(MaxAutoPhotons)));
+/// The automatic photon count (photonsPerPass = 0) from `balance`, the photons whose tracing costs as
+/// much as one camera pass (RenderStats::photonWorkRatio: work units, core/workCount.h, of a camera
+/// pass over those of a photon, both counted by deterministic pilots, so the count is the same on
+/// every machine): PhotonShare x balance, at least one tracing batch (MinAutoPhotons) and at most
+/// MaxAutoPhotons (about 100 MB of photon map).
+/// Why twice the balance: the time to a given noise with P photons a pass is proportional to
+/// (a/P + b)(C + cP) (a/P: the photon map's variance, b: the camera's, C and cP the two passes' costs),
+/// least at P = sqrt(aC/(bc)) = balance x sqrt(r), r = a/(b balance) the photon share of the variance
+/// at equal cost. r is not known before rendering; the photon map is chosen for multiply scattering
+/// media, where photon noise dominates (r = 11 measured on testenv/test_adaptive.py's slab), and
+/// 2x costs at most 12% where r = 1. The former fixed 1e5 made a 4 x 4-pixel check 100x slower with
+/// the photon map than with the path tracer.
+constexpr int MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
+constexpr double PhotonShare = 2.0;
+inline int autoPhotonsPerPass(double balance) {
+    if (!(balance > 0)) return MinAutoPhotons;
+    return static_cast<int>(std::clamp(PhotonShare * balance, double(MinAutoPhotons), double(MaxAutoPhotons)));
 }
 
 /// \class Renderer
@@ -235,6 +245,9 @@ private:
     /// Adaptive sampling: 1 where the pixel is still sampled (all 1 until samplesPerPixel passes).
     std::vector<uint8_t> active_;
     double lastPassSeconds_ = 0;
+    bool usesPhotons_ = false;  ///< the photon-map integrator renders (the scene has media)
+    /// The work (core/workCount.h) of one camera pass, from 256 deterministic camera samples.
+    work::Count cameraPilotWork() const;
     /// After a pass: the active mask and the error statistics from the film.
     void updateAdaptive();
 };

@@ -118,6 +118,9 @@ public:
         return true;
     }
     virtual PathRadiance Li(const Ray& ray, double tMin, double tMax, Rng& rng) const = 0;
+    /// Before pass 0: the work units (workCount.h) one camera pass is expected to take, from a pilot of
+    /// camera samples (Renderer). The photon map sizes its automatic photon count from it.
+    virtual void setCameraWork(const work::Count& perPass) { (void)perPass; }
     /// The denoiser guides of a camera ray (integrator.h, "AOVs"): *albedo and *normal at its first
     /// non-specular vertex (through boundaries and smooth dielectrics); a medium collision is sampled
     /// with the free-flight routine (a real collision accepted with probability average sigma_t /

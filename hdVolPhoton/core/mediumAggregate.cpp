@@ -1,5 +1,7 @@
 #include "core/mediumAggregate.h"
 
+#include "core/workCount.h"
+
 #include <vector>
 
 namespace volphoton {
@@ -11,6 +13,7 @@ bool MediumAggregate::add(const Medium* medium) {
 }
 
 MediumProperties MediumAggregate::properties(const Vec3& p) const {
+    ++work::lookups;
     MediumProperties sum;
     for (int i = 0; i < count_; ++i) {
         MediumProperties mp = media_[i]->properties(p);

@@ -11,8 +11,8 @@
 //    straight line is the single pass's; its shadow rays stop at dielectrics, so light refracted into
 //    a translucent object is all in the photon map).
 //    Camera segments gather them with the beam radiance estimate (photonMap.h); the radius shrinks
-//    per pass as r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1) (Knaus and Zwicker 2011, 2D kernel), so the
-//    average over passes converges.
+//    as r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1) (Knaus and Zwicker 2011, 2D kernel) per 1e5 photons
+//    traced (passRadius), so the average over passes converges.
 //  - Surfaces: direct light by light sampling; indirect light by continuing the camera path with a
 //    diffuse bounce, whose media segments again get single + multiple estimates. So surfaces lit by
 //    media and media lit through surfaces are both counted, each exactly once.
@@ -35,6 +35,7 @@
 #include "core/integratorBase.h"
 #include "core/photonCache.h"
 #include "core/photonMap.h"
+#include "core/workCount.h"
 
 namespace volphoton {
 namespace {
@@ -76,8 +77,7 @@ public:
     bool beginPass(int pass, RenderStats& stats, const CancelCallback& cancel) override {
         if (pass == 0) decidePasses(stats);
         if (!photonsEnabled_) return true;
-        double r = radius_;
-        for (int i = 0; i < pass; ++i) r *= std::sqrt((i + settings_.radiusAlpha) / (i + 1));
+        double r = passRadius(pass);
         stats.photonRadius = r;
         if (cache_) {
             if (std::shared_ptr<const PhotonCache::Pass> kept = cache_->find(pass)) {
@@ -103,6 +103,23 @@ public:
         stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
         if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes, scene_.desc().media);
         return true;
+    }
+
+    void setCameraWork(const work::Count& perPass) override { cameraWork_ = perPass; }
+
+    /// The kernel radius of pass `pass`. Knaus and Zwicker's schedule r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1)
+    /// is r_i^2 = r_0^2 Gamma(i + alpha) / (Gamma(alpha) Gamma(i + 1)); it is applied here to the photons
+    /// traced before the pass counted in units of RadiusReferencePhotons (the former fixed count, for
+    /// which the default initial radius was chosen): x = pass x photonsPerPass / 1e5. So the radius
+    /// shrinks with the photons gathered, not the passes: a render with 4096 photons a pass (a small
+    /// image's automatic count) narrows its kernels 24x more slowly per pass than one with 1e5, and the
+    /// two reach the same radius after the same number of photons (with 1e5 a pass, the formula is the
+    /// recurrence above exactly).
+    double passRadius(int pass) const {
+        constexpr double RadiusReferencePhotons = 1e5;
+        double a = settings_.radiusAlpha, x = double(pass) * photonsPerPass_ / RadiusReferencePhotons;
+        if (!(x > 0) || a >= 1) return radius_;
+        return radius_ * std::exp(0.5 * (std::lgamma(x + a) - std::lgamma(a) - std::lgamma(x + 1)));
     }
 
     PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
@@ -374,12 +391,12 @@ private:
     }
 
     /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
-    /// (index 0) and at stored events (index 1). Batches run in groups, appended in batch order; with
+    /// (index 0) and at stored events (index 1), and into workDone the work counted (workCount.h). Batches run in groups, appended in batch order; with
     /// `thinned`, whenever the photons kept pass twice the memory budget they are thinned to it
     /// (thinToBudget: uniform, power rescaled, so repeated thinning stays unbiased). The pass's peak
     /// memory is then about twice the budget plus one group's photons, not everything traced.
     bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel,
-                      uint64_t* thinned = nullptr) const {
+                      uint64_t* thinned = nullptr, work::Count* workDone = nullptr) const {
         if (!sourceDist_.size() || count <= 0) return true;
         constexpr int GroupBatches = 16;
         const size_t budget = maxPhotons();
@@ -388,17 +405,21 @@ private:
             int g1 = std::min(batches, g0 + GroupBatches);
             std::vector<std::vector<Photon>> perBatch(g1 - g0);
             std::vector<std::array<double, 2>> perEnergy(g1 - g0, {0.0, 0.0});
+            std::vector<work::Count> perWork(g1 - g0);
             std::atomic<bool> cancelled{false};
             tbb::parallel_for(g0, g1, [&](int b) {
                 if (cancelled || (cancel && cancel())) { cancelled = true; return; }
                 Rng rng(hashKeys(0x50484f54ULL, settings_.seed, pass, b, energy ? 1 : 0));
                 int n = std::min(PhotonBatch, count - b * PhotonBatch);
+                work::Snapshot before = work::snapshot();
                 for (int i = 0; i < n; ++i) tracePhoton(rng, count, &perBatch[b - g0], perEnergy[b - g0].data());
+                perWork[b - g0] = work::since(before);
             });
             if (cancelled) return false;
             for (int b = 0; b < g1 - g0; ++b) {
                 photons->insert(photons->end(), perBatch[b].begin(), perBatch[b].end());
                 if (energy) { energy[0] += perEnergy[b][0]; energy[1] += perEnergy[b][1]; }
+                if (workDone) *workDone += perWork[b];
             }
             if (thinned && photons->size() > 2 * budget) *thinned += thinToBudget(pass, round++, photons);
         }
@@ -639,8 +660,10 @@ private:
         // Pilot: the energy reaching second and later scattering events relative to first events.
         std::vector<Photon> pilot;
         uint64_t traced = 0;
+        constexpr int PilotPhotons = 4096;
         double energy[2] = {0, 0};
-        tracePhotons(-1, 4096, &pilot, &traced, energy, {});
+        work::Count pilotWork;
+        tracePhotons(-1, PilotPhotons, &pilot, &traced, energy, {}, nullptr, &pilotWork);
         // No first events but stored ones (light reaching the medium only through a dielectric or a
         // bounce) means everything is the photon map's: an infinite ratio.
         stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : (energy[1] > 0 ? Infinity : 0.0);
@@ -655,7 +678,13 @@ private:
         }
         photonsEnabled_ = true;
         stats.passesRun.push_back("multiple scattering (photons)");
-        photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(settings_.width, settings_.height);
+        // Automatic count: the photon pass as costly as the camera pass, in work units (workCount.h)
+        // measured by the two pilots, not by a clock, so the count is the same on every machine.
+        stats.photonWork = pilotWork * (1.0 / PilotPhotons);
+        stats.cameraWork = cameraWork_;
+        double workPerPhoton = stats.photonWork.units(work::PhotonLookupCost), workPerCameraPass = cameraWork_.units();
+        stats.photonWorkRatio = workPerCameraPass > 0 && workPerPhoton > 0 ? workPerCameraPass / workPerPhoton : 0.0;
+        photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(stats.photonWorkRatio);
         if (cache_) {
             // An automatic count follows the cached maps' (a resized image keeps its photons), unless
             // those maps are not this scene's: then the count is this image's, as without a cache.
@@ -706,6 +735,7 @@ private:
     std::shared_ptr<const PhotonMap> map_;  ///< this pass's map (traced, or kept in cache_)
     std::shared_ptr<PhotonCache> cache_;
     int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
+    work::Count cameraWork_;  ///< the work of a camera pass (Renderer's pilot, setCameraWork)
 };
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "core/scene.h"
 
+#include "core/workCount.h"
+
 #include <sstream>
 #include <stdexcept>
 
@@ -202,6 +204,7 @@ Scene::~Scene() {
 
 bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit) const {
     if (desc_.instances.empty()) return false;
+    ++work::rays;
     // Embree asserts on rays outside its range (|org| <= FLT_LARGE = 1.844e18 in rtcore_ray.h);
     // nothing real lies out there.
     constexpr double FloatSafe = 1e18;

@@ -95,6 +95,13 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
     // The denoiser guides cost a ray per sample: traced only when an albedo or normal AOV is bound.
     for (HdRenderPassAovBinding const &b : aovs)
         if (b.aovName == "albedo" || b.aovName == HdAovTokens->normal) settings.guideAovs = true;
+    // Photons feed only the AOVs holding multiply scattered light (the beauty, multiple, surface): with
+    // none of them bound (a depth or id pass), no photon pass runs.
+    bool photonsShown = aovs.empty();
+    for (HdRenderPassAovBinding const &b : aovs)
+        photonsShown |= b.aovName == HdAovTokens->color || b.aovName == "multiple" || b.aovName == "surface";
+    bool const photonsUnseen = !photonsShown && settings.multipleScattering;
+    if (photonsUnseen) settings.multipleScattering = false;
     for (HdRenderPassAovBinding const &b : aovs)
         if (b.renderBuffer) {
             auto *buffer = static_cast<HdVolPhotonRenderBuffer *>(b.renderBuffer);
@@ -102,7 +109,7 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
                 buffer->Allocate(GfVec3i(width, height, 1), buffer->GetFormat(), false);
             buffer->SetConverged(false);
         }
-    _renderer->SetScene(scene, settings, proj, aovs, _delegate->IsInteractive(), keepPhotons);
+    _renderer->SetScene(scene, settings, proj, aovs, _delegate->IsInteractive(), keepPhotons, photonsUnseen);
     _renderThread->StartRender();
     _started = true;
 }

@@ -20,8 +20,9 @@ using namespace volphoton;
 
 void HdVolPhoton_Renderer::SetScene(std::shared_ptr<Scene const> scene, RenderSettings const &settings,
                                     GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings,
-                                    bool interactive, bool keepPhotons) {
+                                    bool interactive, bool keepPhotons, bool photonsUnseen) {
     _scene = std::move(scene);
+    _photonsUnseen = photonsUnseen;
     if (!keepPhotons || !_photonCache) _photonCache = std::make_shared<PhotonCache>();
     _settings = settings;
     _projection = projection;
@@ -56,7 +57,12 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["photonSeconds"] = VtValue(_stats.photonSeconds);
     d["cameraSeconds"] = VtValue(_stats.cameraSeconds);
     d["passesRun"] = VtValue(VtStringArray(_stats.passesRun.begin(), _stats.passesRun.end()));
-    d["passesSkipped"] = VtValue(VtStringArray(_stats.passesSkipped.begin(), _stats.passesSkipped.end()));
+    VtStringArray skipped(_stats.passesSkipped.begin(), _stats.passesSkipped.end());
+    if (_photonsUnseen)
+        for (std::string &s : skipped)
+            if (s == "multiple scattering (photons): disabled by settings")
+                s = "multiple scattering (photons): no bound AOV shows it (color, multiple, surface)";
+    d["passesSkipped"] = VtValue(skipped);
     d["framesWritten"] = VtValue(_framesWritten);
     d["previewBlock"] = VtValue(_previewBlock);
     d["activePixels"] = VtValue(static_cast<uint64_t>(_stats.activePixels));

@@ -44,12 +44,14 @@ PXR_NAMESPACE_OPEN_SCOPE
 /// the camera, the image size, the AOVs (SetScene's keepPhotons). One volphoton::PhotonCache is kept
 /// until the scene or the render settings change; each restart's photon passes are taken from it
 /// while it has them (bit-identical to tracing them again). Stats: photonPassesReused, photonsReused.
+/// photonsUnseen: the render pass turned the photon pass off because no bound AOV shows multiple
+/// scattering; passesSkipped says so.
 class HdVolPhoton_Renderer
 {
 public:
     void SetScene(std::shared_ptr<volphoton::Scene const> scene, volphoton::RenderSettings const &settings,
                   GfMatrix4d const &projection, HdRenderPassAovBindingVector const &aovBindings, bool interactive,
-                  bool keepPhotons);
+                  bool keepPhotons, bool photonsUnseen = false);
     void Render(HdRenderThread *renderThread);
     bool IsConverged() const;
     VtDictionary GetStats() const;
@@ -64,6 +66,7 @@ private:
 
     std::shared_ptr<volphoton::Scene const> _scene;
     std::shared_ptr<volphoton::PhotonCache> _photonCache;  ///< photon maps of the scene content
+    bool _photonsUnseen = false;
     volphoton::RenderSettings _settings;
     GfMatrix4d _projection{1.0};
     HdRenderPassAovBindingVector _aovBindings;

@@ -30,6 +30,9 @@ py::dict statsToDict(const RenderStats& s) {
     d["camera_seconds"] = s.cameraSeconds;
     d["photon_radius"] = s.photonRadius;
     d["photons_per_pass"] = s.photonsPerPass;
+    d["photon_work_ratio"] = s.photonWorkRatio;
+    d["camera_pass_work"] = py::dict(py::arg("rays") = s.cameraWork.rays, py::arg("lookups") = s.cameraWork.lookups);
+    d["photon_work"] = py::dict(py::arg("rays") = s.photonWork.rays, py::arg("lookups") = s.photonWork.lookups);
     d["photon_passes_reused"] = s.photonPassesReused;
     d["photons_reused"] = s.photonsReused;
     d["multiple_to_single_ratio"] = s.multipleToSingleRatio;

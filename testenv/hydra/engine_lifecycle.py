@@ -153,6 +153,13 @@ def main(scene, camera_path, light_path):
     light.GetOrderedXformOps()[0].Set(Gf.Vec3d(0.3, 3.9, 0.5))
     s = converged_stats()
     check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "a moved light traces photons: %s" % s)
+    # Photons feed only the beauty, multiple and surface AOVs: a depth pass traces none.
+    engine.SetRendererAov("depth")
+    f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), 1.0)))
+    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    s = converged_stats()
+    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 0 and
+          any("no bound AOV" in x for x in s["passesSkipped"]), "a depth pass traces no photons: %s" % s)
     engine.StopRenderer()
     print("OK")
     return 0

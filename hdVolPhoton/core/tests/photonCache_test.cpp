@@ -129,39 +129,57 @@ TEST(PhotonCache, ThePathTracerAndPhotonFreeScenesLeaveItEmpty) {
     EXPECT_EQ(r->stats().photonsPerPass, 0);
 }
 
-TEST(PhotonCount, AutomaticCountFollowsThePixelCountWithinItsBounds) {
-    EXPECT_EQ(autoPhotonsPerPass(4, 4), MinAutoPhotons);
-    EXPECT_EQ(autoPhotonsPerPass(100, 50), 16 * 5000);
-    EXPECT_EQ(autoPhotonsPerPass(1920, 1080), MaxAutoPhotons);
+TEST(PhotonCount, AutomaticCountBalancesTheCameraPassDeterministically) {
+    EXPECT_EQ(autoPhotonsPerPass(0), MinAutoPhotons);
+    EXPECT_EQ(autoPhotonsPerPass(5e4), static_cast<int>(PhotonShare * 5e4));
+    EXPECT_EQ(autoPhotonsPerPass(1e12), MaxAutoPhotons);
+    EXPECT_EQ(RenderSettings().photonsPerPass, 0);  // automatic is the default
     SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
     RenderSettings s = pmSettings(1);
-    s.photonsPerPass = 0;  // the default
-    EXPECT_EQ(RenderSettings().photonsPerPass, 0);
-    for (auto [w, h] : {std::pair{4, 4}, std::pair{40, 30}}) {
+    s.photonsPerPass = 0;
+    auto run = [&](int w, int h, int threads) {
         s.width = w;
         s.height = h;
-        RendererPtr r = rendered(d, s);
-        EXPECT_EQ(r->stats().photonsPerPass, autoPhotonsPerPass(w, h));
-        EXPECT_EQ(r->stats().photonsTraced, static_cast<uint64_t>(autoPhotonsPerPass(w, h)));
+        s.threads = threads;
+        return rendered(d, s)->stats();
+    };
+    RenderStats small = run(40, 30, 0), large = run(160, 120, 0), oneThread = run(160, 120, 1);
+    for (const RenderStats* st : {&small, &large}) {
+        EXPECT_GT(st->photonWorkRatio, 0);
+        EXPECT_EQ(st->photonsPerPass, autoPhotonsPerPass(st->photonWorkRatio));
+        EXPECT_EQ(st->photonsTraced, static_cast<uint64_t>(st->photonsPerPass));
     }
+    // A camera pass is 16x the work at 16x the pixels (the pilot's 256 samples spread over the image
+    // see the same scene; 20% for their different pixels).
+    EXPECT_NEAR(large.photonWorkRatio / small.photonWorkRatio, 16.0, 16 * 0.2);
+    // Counted work, not time: the same on any machine and thread count.
+    EXPECT_EQ(oneThread.photonWorkRatio, large.photonWorkRatio);
+    EXPECT_EQ(oneThread.photonsPerPass, large.photonsPerPass);
+    // An explicit count is used as given, and the path tracer runs no pilot.
+    s.photonsPerPass = 3000;
+    EXPECT_EQ(run(40, 30, 0).photonsPerPass, 3000);
 }
 
 TEST(PhotonCount, AResizedImageKeepsTheCachedAutomaticCount) {
     SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
     RenderSettings s = pmSettings(2);
     s.photonsPerPass = 0;
-    s.width = s.height = 20;  // 6400 photons
+    s.width = s.height = 100;
     auto cache = std::make_shared<PhotonCache>();
-    rendered(d, s, cache);
-    s.width = s.height = 30;  // would be 14400
+    RendererPtr first = rendered(d, s, cache);
+    s.width = s.height = 150;
     RendererPtr resized = rendered(d, s, cache);
-    EXPECT_EQ(resized->stats().photonsPerPass, autoPhotonsPerPass(20, 20));
+    RendererPtr resizedAlone = rendered(d, s);
+    EXPECT_NE(resizedAlone->stats().photonsPerPass, first->stats().photonsPerPass);  // 2.25x the pixels
+    EXPECT_EQ(resized->stats().photonsPerPass, first->stats().photonsPerPass);
     EXPECT_EQ(resized->stats().photonPassesReused, 2);
     // Another scene in the same cache: the count is this image's again.
-    RendererPtr other = rendered(fogScene(Vec3(1.2, 0.5, 0.5)), s, cache);
-    EXPECT_EQ(other->stats().photonsPerPass, autoPhotonsPerPass(30, 30));
-    EXPECT_EQ(other->stats().photonPassesReused, 0);
-    EXPECT_EQ(beauty(other), beauty(rendered(fogScene(Vec3(1.2, 0.5, 0.5)), s)));
+    SceneDesc other = fogScene(Vec3(1.2, 0.5, 0.5));
+    RendererPtr otherCached = rendered(other, s, cache);
+    RendererPtr otherAlone = rendered(other, s);
+    EXPECT_EQ(otherCached->stats().photonsPerPass, otherAlone->stats().photonsPerPass);
+    EXPECT_EQ(otherCached->stats().photonPassesReused, 0);
+    EXPECT_EQ(beauty(otherCached), beauty(otherAlone));
 }
 
 }  // namespace volphoton
