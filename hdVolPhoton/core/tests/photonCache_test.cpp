@@ -183,3 +183,51 @@ TEST(PhotonCount, AResizedImageKeepsTheCachedAutomaticCount) {
 }
 
 }  // namespace volphoton
+
+namespace volphoton {
+
+TEST(PhotonMapConsistency, KernelBiasFallsAsPhotonsAccumulate) {
+    // A fog cube lit from the side (+x), seen along its axis: a kernel disc of radius 1 (set large on
+    // purpose) around the axis reaches the cube's faces, beyond which there are no photons, and
+    // underestimates. Averaged over passes with the radius shrinking per photon traced (passRadius),
+    // the photon map's error against the path tracer (unbiased; 16 seeds) must fall: the kernel bias
+    // goes as r^2, whose average over 64 passes of 1e4 photons is 0.42 of the first pass's with the
+    // default alpha 0.7. Measured: -13% after 1 pass, -5.5% after 64 (errors 7.1e-3 and 2.9e-3,
+    // standard errors 5e-4 and 3e-4).
+    SceneDesc d;
+    auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(0.95), Spectrum(1.0), Spectrum(0.0), makeIsotropicPhase());
+    d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
+    d.unboundedMedia.push_back(0);
+    d.lights.push_back(makeDistantLight(Vec3(-1, 0, 0), 0.0, Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, 4), Vec3(0, 0, 0));
+    d.camera.projection = CameraDesc::Projection::Orthographic;
+    d.camera.orthoWidth = 0.2;  // the cube's axis only
+    auto scene = std::make_shared<Scene>(d);
+    auto multiple = [&](RenderSettings s, int seeds) {
+        std::vector<double> xs;
+        for (int seed = 0; seed < seeds; ++seed) {
+            s.seed = seed;
+            Renderer r(scene, s);
+            r.render();
+            xs.push_back(test::aovMean(r.film(), Film::Multiple));
+        }
+        return test::meanAndError(xs);
+    };
+    RenderSettings pt = test::smallSettings(RenderSettings::Integrator::PathTracer, 256, 0);
+    pt.width = pt.height = 4;
+    auto ref = multiple(pt, 16);
+    RenderSettings pm = test::smallSettings(RenderSettings::Integrator::PhotonMap, 1, 0);
+    pm.width = pm.height = 4;
+    pm.photonsPerPass = 10000;
+    pm.initialRadius = 1.0;
+    auto few = multiple(pm, 16);
+    pm.samplesPerPixel = 64;
+    auto many = multiple(pm, 8);
+    double errFew = few.mean - ref.mean, errMany = many.mean - ref.mean;
+    std::printf("multiple: path tracer %.4f +- %.4f, photon map 1 pass %.4f +- %.4f, 64 passes %.4f +- %.4f\n", ref.mean,
+                ref.stderr_, few.mean, few.stderr_, many.mean, many.stderr_);
+    EXPECT_GT(std::abs(errFew), 4 * std::hypot(few.stderr_, ref.stderr_));  // the bias is there to see
+    EXPECT_LT(std::abs(errMany), 0.7 * std::abs(errFew));
+}
+
+}  // namespace volphoton
