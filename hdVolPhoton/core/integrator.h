@@ -32,7 +32,7 @@
 // |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
 // | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: as many |
-// |                     |        |            |              | as cost two camera passes (pilots count work, not |
+// |                     |        |            |              | as cost one camera pass (pilots count work, not   |
 // |                     |        |            |              | time), in [4096, 1e6] (autoPhotonsPerPass), or the|
 // |                     |        |            |              | count of the maps a PhotonCache keeps             |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
@@ -44,6 +44,10 @@
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
 // |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
+// | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
+// |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
+// |                     |        |            |              | photon points; the radius is then the beams' and  |
+// |                     |        |            |              | shrinks as r (i+alpha)/(i+1)                      |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
 // |                     |        |            |              | the media's diameter, else of the scene's)        |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |
@@ -116,6 +120,7 @@ struct RenderSettings {
     double initialRadius = 0;
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 8;
+    bool photonBeams = false;
     int stratifiedDims = 32;
     double marchStep = 0;
     bool singleScattering = true;
@@ -169,15 +174,17 @@ class PhotonCache;
 /// pass over those of a photon, both counted by deterministic pilots, so the count is the same on
 /// every machine): PhotonShare x balance, at least one tracing batch (MinAutoPhotons) and at most
 /// MaxAutoPhotons (about 100 MB of photon map).
-/// Why twice the balance: the time to a given noise with P photons a pass is proportional to
-/// (a/P + b)(C + cP) (a/P: the photon map's variance, b: the camera's, C and cP the two passes' costs),
-/// least at P = sqrt(aC/(bc)) = balance x sqrt(r), r = a/(b balance) the photon share of the variance
-/// at equal cost. r is not known before rendering; the photon map is chosen for multiply scattering
-/// media, where photon noise dominates (r = 11 measured on testenv/test_adaptive.py's slab), and
-/// 2x costs at most 12% where r = 1. The former fixed 1e5 made a 4 x 4-pixel check 100x slower with
-/// the photon map than with the path tracer.
+/// Why equal cost: the time to a given noise with P photons a pass is proportional to
+/// (a/P + b)(C + cP) (a/P: the photon map's variance, b: the camera side's, C and cP the two passes'
+/// costs), least at P = sqrt(aC/(bc)) = balance x sqrt(r), r = a/(b balance) the photons' share of
+/// the variance at equal cost. r is not known before rendering and ranges widely: 11 on
+/// testenv/test_adaptive.py's slab (photon noise dominates), about 0.04 on the fog + spot benchmark
+/// scene (the single-scattering march dominates). Equal cost is at most 1.3x (slab) and 1.45x (fog)
+/// slower than the best split for either; twice the balance would be 1.05x and 2.1x.
+/// The former fixed 1e5 made a 4 x 4-pixel check 14x slower (vdb_cloud, 64 passes: 3.45 s of photons
+/// against 0.24 s at 4096).
 constexpr int MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
-constexpr double PhotonShare = 2.0;
+constexpr double PhotonShare = 1.0;
 inline int autoPhotonsPerPass(double balance) {
     if (!(balance > 0)) return MinAutoPhotons;
     return static_cast<int>(std::clamp(PhotonShare * balance, double(MinAutoPhotons), double(MaxAutoPhotons)));

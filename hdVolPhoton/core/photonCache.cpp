@@ -1,10 +1,13 @@
 #include "core/photonCache.h"
 
+#include "core/photonBeams.h"
 #include "core/photonMap.h"
 
 #include <algorithm>
 
 namespace volphoton {
+
+size_t PhotonCache::Pass::bytes() const { return (map ? map->bytes() : 0) + (beams ? beams->bytes() : 0); }
 
 bool PhotonCache::use(uint64_t key) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -26,8 +29,8 @@ std::shared_ptr<const PhotonCache::Pass> PhotonCache::find(int pass) const {
 
 bool PhotonCache::store(int pass, Pass entry, size_t budgetBytes, const std::vector<MediumPtr>& media) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!entry.map || passes_.count(pass)) return false;
-    size_t b = entry.map->bytes();
+    if ((!entry.map && !entry.beams) || passes_.count(pass)) return false;
+    size_t b = entry.bytes();
     if (bytes_ + b > budgetBytes) return false;
     bytes_ += b;
     passes_[pass] = std::make_shared<const Pass>(std::move(entry));

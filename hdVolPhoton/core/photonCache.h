@@ -13,6 +13,7 @@
 namespace volphoton {
 
 class PhotonMap;
+class PhotonBeamMap;
 
 /// \class PhotonCache
 /// Front ends keep one per scene content and hand it to every Renderer of that content: the Hydra
@@ -35,10 +36,12 @@ class PhotonMap;
 class PhotonCache {
 public:
     struct Pass {
-        std::shared_ptr<const PhotonMap> map;
+        std::shared_ptr<const PhotonMap> map;        ///< points, or
+        std::shared_ptr<const PhotonBeamMap> beams;  ///< beams (RenderSettings::photonBeams)
         uint64_t traced = 0;         ///< photons traced for it
         uint64_t thinned = 0;        ///< photons the memory budget dropped
         uint64_t radiusCapped = 0;   ///< stored photons whose kernel the mean-free-path cap narrowed
+        size_t bytes() const;
     };
 
     /// Makes `key` current: a different key than the one the cached maps were traced under empties

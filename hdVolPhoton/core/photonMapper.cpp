@@ -34,6 +34,7 @@
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
 #include "core/photonCache.h"
+#include "core/photonBeams.h"
 #include "core/photonMap.h"
 #include "core/workCount.h"
 
@@ -53,6 +54,7 @@ public:
         radius_ = settings.initialRadius > 0 ? settings.initialRadius : diameter / 100;
         step_ = settings.marchStep > 0 ? settings.marchStep : diameter / 256;
         aim_ = {scene.center(), scene.radius(), scene.mediaCenter(), scene.mediaRadius(), Bounds3()};
+        sceneBox_ = {scene.center() - Vec3(1, 1, 1) * scene.radius(), scene.center() + Vec3(1, 1, 1) * scene.radius()};
         // Nothing lies outside the scene's box unless a medium is unbounded.
         if (scene.mediaRadius() > 0) aim_.box = scene.bounds();
         std::vector<double> extended, point;
@@ -77,35 +79,55 @@ public:
     bool beginPass(int pass, RenderStats& stats, const CancelCallback& cancel) override {
         if (pass == 0) decidePasses(stats);
         if (!photonsEnabled_) return true;
-        double r = passRadius(pass);
+        double r = settings_.photonBeams ? passBeamRadius(pass) : passRadius(pass);
         stats.photonRadius = r;
         if (cache_) {
             if (std::shared_ptr<const PhotonCache::Pass> kept = cache_->find(pass)) {
                 map_ = kept->map;
+                beams_ = kept->beams;
+                size_t n = map_ ? map_->size() : beams_ ? beams_->size() : 0;
                 stats.photonPassesReused += 1;
-                stats.photonsReused += map_->size();
-                stats.photonsStored += map_->size();
+                stats.photonsReused += n;
+                stats.photonsStored += n;
                 stats.photonsRadiusCapped += kept->radiusCapped;
-                stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
+                stats.photonMapBytes = std::max(stats.photonMapBytes, kept->bytes());
                 return true;
             }
         }
-        std::vector<Photon> photons;
+        PhotonRecords records;
+        records.wantBeams = settings_.photonBeams;
         PhotonCache::Pass traced;
-        if (!tracePhotons(pass, photonsPerPass_, &photons, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
-        traced.radiusCapped = noteNarrowKernels(photons, r);
-        traced.map = std::make_shared<const PhotonMap>(std::move(photons), r);
-        map_ = traced.map;
+        if (!tracePhotons(pass, photonsPerPass_, &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
+        size_t stored, bytes;
+        if (settings_.photonBeams) {
+            traced.beams = std::make_shared<const PhotonBeamMap>(std::move(records.beams), r);
+            beams_ = traced.beams;
+            stored = beams_->size();
+            bytes = beams_->bytes();
+        } else {
+            traced.radiusCapped = noteNarrowKernels(records.photons, r);
+            traced.map = std::make_shared<const PhotonMap>(std::move(records.photons), r);
+            map_ = traced.map;
+            stored = map_->size();
+            bytes = map_->bytes();
+        }
         stats.photonsTraced += traced.traced;
         stats.photonsThinned += traced.thinned;
         stats.photonsRadiusCapped += traced.radiusCapped;
-        stats.photonsStored += map_->size();
-        stats.photonMapBytes = std::max(stats.photonMapBytes, map_->bytes());
+        stats.photonsStored += stored;
+        stats.photonMapBytes = std::max(stats.photonMapBytes, bytes);
         if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes, scene_.desc().media);
         return true;
     }
 
     void setCameraWork(const work::Count& perPass) override { cameraWork_ = perPass; }
+
+    /// The beam radius of pass `pass` (photonBeams): the 1D kernel's schedule r_{i+1} = r_i (i + alpha)/(i + 1)
+    /// (Jarosz et al. 2011, "Progressive photon beams", eq. 21), counted in 1e5 photons as passRadius.
+    double passBeamRadius(int pass) const {
+        double r = passRadius(pass) / radius_;
+        return radius_ * r * r;
+    }
 
     /// The kernel radius of pass `pass`. Knaus and Zwicker's schedule r_{i+1}^2 = r_i^2 (i + alpha)/(i + 1)
     /// is r_i^2 = r_0^2 Gamma(i + alpha) / (Gamma(alpha) Gamma(i + 1)); it is applied here to the photons
@@ -311,6 +333,8 @@ private:
         if (map_) {
             double beam = map_->radius();
             r.multiple = gather(ray, std::max(0.0, supportStart - beam), std::min(length, supportEnd + beam), tr, stack);
+        } else if (beams_) {
+            r.multiple = gatherBeams(media, ray, supportStart, std::min(length, supportEnd), tr, stack);
         }
         return r;
     }
@@ -390,12 +414,42 @@ private:
         return sum;
     }
 
+    /// Beam x beam 1D with short beams (photonBeams.h): flux sigma_s p / (2 r sin theta) T_camera.
+    Spectrum gatherBeams(const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
+                         const MediumStack& stack) const {
+        Spectrum sum;
+        int region = stack.innermost();
+        double kernel = 1 / (2 * beams_->radius());
+        beams_->query(ray, a, b, [&](const BeamHit& h) {
+            const PhotonBeam& beam = *h.beam;
+            if (beam.region != region) return;
+            Vec3 x(beam.origin[0] + beam.dir[0] * h.sBeam, beam.origin[1] + beam.dir[1] * h.sBeam,
+                   beam.origin[2] + beam.dir[2] * h.sBeam);
+            Spectrum f = media.properties(x).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
+            if (f.isBlack()) return;
+            sum += Spectrum(beam.power[0], beam.power[1], beam.power[2]) * f * tr.at(h.tCamera) * (kernel / h.sinTheta);
+        });
+        return sum;
+    }
+
+    /// What a photon pass stores: points (Photon) or, with photonBeams, beams.
+    struct PhotonRecords {
+        bool wantBeams = false;  ///< store beams instead of points
+        std::vector<Photon> photons;
+        std::vector<PhotonBeam> beams;
+        size_t size() const { return photons.size() + beams.size(); }
+        void append(PhotonRecords&& o) {
+            photons.insert(photons.end(), o.photons.begin(), o.photons.end());
+            beams.insert(beams.end(), o.beams.begin(), o.beams.end());
+        }
+    };
+
     /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
     /// (index 0) and at stored events (index 1), and into workDone the work counted (workCount.h). Batches run in groups, appended in batch order; with
     /// `thinned`, whenever the photons kept pass twice the memory budget they are thinned to it
     /// (thinToBudget: uniform, power rescaled, so repeated thinning stays unbiased). The pass's peak
     /// memory is then about twice the budget plus one group's photons, not everything traced.
-    bool tracePhotons(int pass, int count, std::vector<Photon>* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel,
+    bool tracePhotons(int pass, int count, PhotonRecords* photons, uint64_t* traced, double energy[2], const CancelCallback& cancel,
                       uint64_t* thinned = nullptr, work::Count* workDone = nullptr) const {
         if (!sourceDist_.size() || count <= 0) return true;
         constexpr int GroupBatches = 16;
@@ -403,7 +457,8 @@ private:
         int batches = (count + PhotonBatch - 1) / PhotonBatch, round = 0;
         for (int g0 = 0; g0 < batches; g0 += GroupBatches) {
             int g1 = std::min(batches, g0 + GroupBatches);
-            std::vector<std::vector<Photon>> perBatch(g1 - g0);
+            std::vector<PhotonRecords> perBatch(g1 - g0);
+            for (PhotonRecords& r : perBatch) r.wantBeams = photons->wantBeams;
             std::vector<std::array<double, 2>> perEnergy(g1 - g0, {0.0, 0.0});
             std::vector<work::Count> perWork(g1 - g0);
             std::atomic<bool> cancelled{false};
@@ -417,7 +472,7 @@ private:
             });
             if (cancelled) return false;
             for (int b = 0; b < g1 - g0; ++b) {
-                photons->insert(photons->end(), perBatch[b].begin(), perBatch[b].end());
+                photons->append(std::move(perBatch[b]));
                 if (energy) { energy[0] += perEnergy[b][0]; energy[1] += perEnergy[b][1]; }
                 if (workDone) *workDone += perWork[b];
             }
@@ -429,7 +484,10 @@ private:
     }
 
     /// Photons that fit in settings.photonMapBudgetBytes (at least one).
-    size_t maxPhotons() const { return std::max<size_t>(1, settings_.photonMapBudgetBytes / PhotonMap::BytesPerPhoton); }
+    size_t maxPhotons() const {
+        size_t per = settings_.photonBeams ? PhotonBeamMap::BytesPerBeam : PhotonMap::BytesPerPhoton;
+        return std::max<size_t>(1, settings_.photonMapBudgetBytes / per);
+    }
 
     /// An emissive medium as a photon source: uniform points in `box` where the medium is present,
     /// uniform directions. Volume emission is photon-traced so that its scattered light (which the
@@ -449,12 +507,11 @@ private:
     }
 
     void findEmitters() {
-        Bounds3 sceneBox{scene_.center() - Vec3(1, 1, 1) * scene_.radius(), scene_.center() + Vec3(1, 1, 1) * scene_.radius()};
         auto add = [&](const Medium* m, int mesh) {
             if (!m->isEmissive()) return;
             Bounds3 b = m->bounds(), box;
-            box.lo = vmax(b.lo, sceneBox.lo);
-            box.hi = vmin(b.hi, sceneBox.hi);
+            box.lo = vmax(b.lo, sceneBox_.lo);
+            box.hi = vmin(b.hi, sceneBox_.hi);
             if (box.empty()) return;
             Vec3 size = box.hi - box.lo;
             Emitter e{m, mesh, box, size.x * size.y * size.z, 0.0};
@@ -473,7 +530,35 @@ private:
         }
     }
 
-    void tracePhoton(Rng& rng, int count, std::vector<Photon>* out, double energy[2]) const {
+    /// The stretch [t0, t1] of a photon's flight along ray, clipped to the media's box within the
+    /// scene's (a flight from a floor to a fog box, or out to an unbounded distance, has no beam
+    /// outside them), as a beam carrying `flux`.
+    void addBeamPiece(const Ray& ray, double t0, double t1, const Spectrum& flux, const Medium& media, int region,
+                      std::vector<PhotonBeam>* out) const {
+        Bounds3 b = media.bounds(), box;
+        box.lo = vmax(b.lo, sceneBox_.lo);
+        box.hi = vmin(b.hi, sceneBox_.hi);
+        for (int a = 0; a < 3; ++a) {
+            double inv = 1 / ray.d[a];
+            double n = (box.lo[a] - ray.o[a]) * inv, f = (box.hi[a] - ray.o[a]) * inv;
+            if (n > f) std::swap(n, f);
+            if (!std::isnan(n)) t0 = std::max(t0, n);
+            if (!std::isnan(f)) t1 = std::min(t1, f);
+        }
+        if (!(t1 > t0) || flux.isBlack()) return;
+        PhotonBeam beam;
+        Vec3 o = ray.at(t0);
+        for (int c = 0; c < 3; ++c) {
+            beam.origin[c] = static_cast<float>(o[c]);
+            beam.dir[c] = static_cast<float>(ray.d[c]);
+            beam.power[c] = static_cast<float>(flux[c]);
+        }
+        beam.length = static_cast<float>(t1 - t0);
+        beam.region = region;
+        out->push_back(beam);
+    }
+
+    void tracePhoton(Rng& rng, int count, PhotonRecords* out, double energy[2]) const {
         double pick;
         size_t source = sourceDist_.sampleDiscrete(rng.uniform(), &pick);
         double u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
@@ -504,19 +589,36 @@ private:
             MediumEvent ev{};
             MediumAggregate media = scene_.mediaFor(stack);
             if (media.size()) {
+                // Beams (photonBeams) of multiply scattered light: the flight in pieces of constant
+                // spectral weight, each ending where the flight or the weight changed (photonBeams.h).
+                const bool beams = out->wantBeams && events >= 1;
+                double pieceStart = 0;
+                auto addBeam = [&](double t1) {
+                    if (beams) addBeamPiece(ray, pieceStart, t1, flux, media, stack.innermost(), &out->beams);
+                    pieceStart = t1;
+                };
                 FlightEnd end = sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
                     Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
                     for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
                     double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
                     double pn = (sigma_n * flux).average(), total = pa + ps + pn;
-                    if (!(total > 0)) { absorbed = true; return false; }
+                    if (!(total > 0)) { absorbed = true; addBeam(m.t); return false; }
                     double x = rng.uniform() * total;
-                    if (x < pa) { absorbed = true; return false; }
-                    if (x < pa + ps) { flux *= total / (m.sigmaMaj * ps); ev = m; scattered = true; return false; }
-                    flux *= sigma_n * (total / (m.sigmaMaj * pn));
+                    if (x < pa) { absorbed = true; addBeam(m.t); return false; }
+                    if (x < pa + ps) {
+                        addBeam(m.t);
+                        flux *= total / (m.sigmaMaj * ps);
+                        ev = m;
+                        scattered = true;
+                        return false;
+                    }
+                    Spectrum weight = sigma_n * (total / (m.sigmaMaj * pn));
+                    if (beams && std::abs(weight.maxValue() - 1) + std::abs(weight.minValue() - 1) > 1e-6) addBeam(m.t);
+                    flux *= weight;
                     return true;
                 });
                 absorbed |= end == FlightEnd::Truncated;
+                if (end == FlightEnd::Escaped) addBeam(tEnd);
             }
             if (absorbed) return;
             if (scattered) {
@@ -534,7 +636,7 @@ private:
                 double lobeProb = mp.lobes[lobe].sigma_s.average() / total;
                 Spectrum stored = flux * mp.lobes[lobe].sigma_s / lobeProb;
                 if (energy) energy[events >= 1 ? 1 : 0] += (flux * mp.sigma_s).average();
-                if (events >= 1) {
+                if (events >= 1 && !out->wantBeams) {
                     Photon ph;
                     for (int c = 0; c < 3; ++c) {
                         ph.p[c] = static_cast<float>(ev.p[c]);
@@ -544,7 +646,7 @@ private:
                     ph.phase = mp.lobes[lobe].phase;
                     ph.region = stack.innermost();
                     ph.radius = ph.region < 0 ? radiusCap(mp.sigma_t().maxValue()) : std::numeric_limits<float>::infinity();
-                    out->push_back(ph);
+                    out->photons.push_back(ph);
                 }
                 ++events;
                 if (++depth >= DeepRouletteDepth) {  // albedo 1 loses nothing: end deep photons too
@@ -619,7 +721,11 @@ private:
     /// Keeps the photon map within the memory budget: exactly `budget` photons survive, chosen
     /// uniformly without replacement (a partial Fisher-Yates shuffle with a seeded stream), and
     /// their power is scaled by size / budget, so the estimate stays unbiased.
-    uint64_t thinToBudget(int pass, int round, std::vector<Photon>* photons) const {
+    uint64_t thinToBudget(int pass, int round, PhotonRecords* records) const {
+        return thinToBudget(pass, round, &records->photons) + thinToBudget(pass, round, &records->beams);
+    }
+    template <typename Record>
+    uint64_t thinToBudget(int pass, int round, std::vector<Record>* photons) const {
         const size_t maxPhotons = this->maxPhotons();
         size_t n = photons->size();
         if (n <= maxPhotons) return 0;
@@ -631,7 +737,7 @@ private:
         double scale = static_cast<double>(n) / maxPhotons;
         photons->resize(maxPhotons);
         photons->shrink_to_fit();
-        for (Photon& ph : *photons)
+        for (Record& ph : *photons)
             for (float& c : ph.power) c = static_cast<float>(c * scale);
         uint64_t dropped = n - maxPhotons;
         if (!warnedBudget_.exchange(true))
@@ -658,12 +764,13 @@ private:
         for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
         if (maxAlbedo == 0) { stats.passesSkipped.push_back("multiple scattering (photons): every medium has albedo 0"); return; }
         // Pilot: the energy reaching second and later scattering events relative to first events.
-        std::vector<Photon> pilot;
+        PhotonRecords pilotRecords;  // points: their records key the PhotonCache
         uint64_t traced = 0;
         constexpr int PilotPhotons = 4096;
         double energy[2] = {0, 0};
         work::Count pilotWork;
-        tracePhotons(-1, PilotPhotons, &pilot, &traced, energy, {}, nullptr, &pilotWork);
+        tracePhotons(-1, PilotPhotons, &pilotRecords, &traced, energy, {}, nullptr, &pilotWork);
+        const std::vector<Photon>& pilot = pilotRecords.photons;
         // No first events but stored ones (light reaching the medium only through a dielectric or a
         // bounce) means everything is the photon map's: an infinite ratio.
         stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : (energy[1] > 0 ? Infinity : 0.0);
@@ -709,7 +816,7 @@ private:
             return u;
         };
         uint64_t h = hashKeys(settings_.seed, photonsPerPass, bits(radius_), bits(settings_.radiusAlpha),
-                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonMapBudgetBytes, pilot.size(),
+                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonBeams, settings_.photonMapBudgetBytes, pilot.size(),
                               sourceDist_.size(), scene_.lights().size());
         for (const Photon& ph : pilot) {
             uint32_t w[11];
@@ -725,6 +832,7 @@ private:
 
     double radius_, step_;
     PhotonAim aim_;  ///< where distant and dome light photons enter the scene
+    Bounds3 sceneBox_;  ///< the scene's bounding sphere's box
     bool warnedNarrow_ = false;
     mutable std::atomic<bool> warnedBudget_{false};
     std::vector<int> pointLights_;
@@ -733,6 +841,7 @@ private:
     Distribution1D sourceDist_;  ///< lights, then emitters_, by power
     bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false;
     std::shared_ptr<const PhotonMap> map_;  ///< this pass's map (traced, or kept in cache_)
+    std::shared_ptr<const PhotonBeamMap> beams_;  ///< or its beams (photonBeams)
     std::shared_ptr<PhotonCache> cache_;
     int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
     work::Count cameraWork_;  ///< the work of a camera pass (Renderer's pilot, setCameraWork)

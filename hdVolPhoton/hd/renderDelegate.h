@@ -25,7 +25,7 @@ class HdVolPhotonRenderParam;
 /// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
 /// | volphoton:maxDepth           | int   | 100000     | events per path (safety cap; lower: biased)  |
-/// | volphoton:photonsPerPass     | int   | 0 (auto)   | photonMap: photons per pass (auto: 16/pixel) |
+/// | volphoton:photonsPerPass     | int   | 0 (auto)   | photonMap: photons per pass (auto: balanced) |
 /// | volphoton:initialRadius      | float | 0 (auto)   | photonMap: beam radius of pass 0             |
 /// | volphoton:singleScattering   | bool  | true       | photonMap: single-scattering pass on/off     |
 /// | volphoton:multipleScattering | bool  | true       | photonMap: photon pass on/off                |
@@ -34,6 +34,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:stratifiedDims     | int   | 32         | draws per camera sample from Sobol' points   |
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
 /// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
+/// | volphoton:photonBeams        | bool  | false      | photonMap: photon beams instead of points    |
 /// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
 /// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |

@@ -65,6 +65,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["initialRadius"] = s.initialRadius;
     d["radiusAlpha"] = s.radiusAlpha;
     d["photonRadiusMfp"] = s.photonRadiusMfp;
+    d["photonBeams"] = s.photonBeams;
     d["stratifiedDims"] = s.stratifiedDims;
     d["marchStep"] = s.marchStep;
     d["singleScattering"] = s.singleScattering;
@@ -200,6 +201,7 @@ void bindRender(py::module_& m) {
         .def_readwrite("initial_radius", &RenderSettings::initialRadius)
         .def_readwrite("radius_alpha", &RenderSettings::radiusAlpha)
         .def_readwrite("photon_radius_mfp", &RenderSettings::photonRadiusMfp)
+        .def_readwrite("photon_beams", &RenderSettings::photonBeams)
         .def_readwrite("stratified_dims", &RenderSettings::stratifiedDims)
         .def_readwrite("march_step", &RenderSettings::marchStep)
         .def_readwrite("single_scattering", &RenderSettings::singleScattering)

@@ -1083,6 +1083,7 @@ SETTING_CASES = {
     "marchStep": ("float volphoton:marchStep = 0.05", PHOTON_MAP, "pixels"),
     "singleScattering": ("bool volphoton:singleScattering = 0", PHOTON_MAP, "darker"),
     "multipleScattering": ("bool volphoton:multipleScattering = 0", PHOTON_MAP, "darker"),
+    "photonBeams": ("bool volphoton:photonBeams = 1", PHOTON_MAP, "pixels"),
     "multipleThreshold": ("float volphoton:multipleThreshold = 1000000", PHOTON_MAP, "darker"),
     "transmittanceCutoff": ("float volphoton:transmittanceCutoff = 0.5", [], "pixels"),
     # Adaptive sampling: an unreachable target renders to the cap (32 passes instead of SPP); a cap

@@ -408,6 +408,35 @@ TEST(IntegratorAgreement, PhotonSinglePlusMultipleEqualsPathTracerBeauty) {
     EXPECT_GT(ptMultiple.mean, 0.1 * ptSingle.mean);  // the scene has real multiple scattering to compare
 }
 
+TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
+    // Chromatic fog (spectral-tracking weights split beams), a distant and a sphere light, and a floor
+    // (beams after a diffuse bounce): the beams' multiple scattering must match the path tracer's.
+    SceneDesc d = mediaOnlyScene();
+    MeshDesc floor;
+    floor.name = "floor";
+    floor.points = {Vec3(-4, -1.2, -4), Vec3(4, -1.2, -4), Vec3(4, -1.2, 4), Vec3(-4, -1.2, 4)};
+    floor.indices = {0, 2, 1, 0, 3, 2};
+    floor.material.albedo = Spectrum(0.7);
+    d.meshes.push_back(floor);
+    d.instances.push_back({0, Affine()});
+    RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+    RenderSettings beams = smallSettings(RenderSettings::Integrator::PhotonMap, 16, 0);
+    beams.photonsPerPass = 4000;
+    beams.photonBeams = true;
+    for (int c = 0; c < 3; ++c) {
+        auto ptMultiple = imageMean(d, pt, [c](const Film& f) { return aovMean(f, Film::Multiple, c); });
+        auto beamMultiple = imageMean(d, beams, [c](const Film& f) { return aovMean(f, Film::Multiple, c); });
+        double sigma = std::hypot(ptMultiple.stderr_, beamMultiple.stderr_);
+        std::printf("multiple, channel %d: path tracer %.5f +- %.5f, beams %.5f +- %.5f\n", c, ptMultiple.mean,
+                    ptMultiple.stderr_, beamMultiple.mean, beamMultiple.stderr_);
+        EXPECT_NEAR(beamMultiple.mean, ptMultiple.mean, 4 * sigma + 0.02 * ptMultiple.mean) << "channel " << c;
+        EXPECT_LT(4 * sigma, 0.05 * ptMultiple.mean) << "channel " << c;  // the check has teeth
+    }
+    auto beauty = imageMean(d, beams, [](const Film& f) { return aovMean(f, Film::Beauty); });
+    auto ptBeauty = imageMean(d, pt, [](const Film& f) { return aovMean(f, Film::Beauty); });
+    EXPECT_NEAR(beauty.mean, ptBeauty.mean, 4 * std::hypot(beauty.stderr_, ptBeauty.stderr_) + 0.01 * ptBeauty.mean);
+}
+
 TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     // A floor under a fog box: the floor sees light scattered by the fog, the fog sees light bounced
     // by the floor. Both integrators must agree on the whole image.

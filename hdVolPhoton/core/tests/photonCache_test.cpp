@@ -41,22 +41,29 @@ RendererPtr rendered(const SceneDesc& d, const RenderSettings& s, std::shared_pt
 }  // namespace
 
 TEST(PhotonCache, ACameraMoveReusesEveryPassAndMatchesAFreshRender) {
-    auto cache = std::make_shared<PhotonCache>();
-    RenderSettings s = pmSettings(4);
-    RendererPtr first = rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
-    EXPECT_EQ(first->stats().photonPassesReused, 0);
-    EXPECT_EQ(first->stats().photonsTraced, 4u * 3000);
-    EXPECT_EQ(cache->passes(), 4u);
-    EXPECT_EQ(cache->photonsPerPass(), 3000);
-    // The same lights and media from elsewhere, in a scene built anew (as each front end does).
-    SceneDesc moved = fogScene(Vec3(1.5, 0.5, 0.5), Vec3(-2.5, 1.0, 2.5));
-    RendererPtr reused = rendered(moved, s, cache);
-    RendererPtr fresh = rendered(moved, s);
-    EXPECT_EQ(reused->stats().photonPassesReused, 4);
-    EXPECT_EQ(reused->stats().photonsTraced, 0u);
-    EXPECT_EQ(reused->stats().photonsReused, fresh->stats().photonsStored);
-    EXPECT_EQ(beauty(reused), beauty(fresh));  // bit-identical: a reused pass is the pass it would trace
-    EXPECT_NE(beauty(reused), beauty(first));  // (the camera did move)
+    for (bool beams : {false, true}) {
+        auto cache = std::make_shared<PhotonCache>();
+        RenderSettings s = pmSettings(4);
+        s.photonBeams = beams;
+        RendererPtr first = rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+        EXPECT_EQ(first->stats().photonPassesReused, 0);
+        EXPECT_EQ(first->stats().photonsTraced, 4u * 3000);
+        EXPECT_EQ(cache->passes(), 4u);
+        EXPECT_EQ(cache->photonsPerPass(), 3000);
+        // The same lights and media from elsewhere, in a scene built anew (as each front end does).
+        SceneDesc moved = fogScene(Vec3(1.5, 0.5, 0.5), Vec3(-2.5, 1.0, 2.5));
+        RendererPtr reused = rendered(moved, s, cache);
+        RendererPtr fresh = rendered(moved, s);
+        EXPECT_EQ(reused->stats().photonPassesReused, 4) << "beams " << beams;
+        EXPECT_EQ(reused->stats().photonsTraced, 0u);
+        EXPECT_EQ(reused->stats().photonsReused, fresh->stats().photonsStored);
+        EXPECT_GT(fresh->stats().photonsStored, 0u);
+        EXPECT_EQ(beauty(reused), beauty(fresh));  // bit-identical: a reused pass is the pass it would trace
+        EXPECT_NE(beauty(reused), beauty(first));  // (the camera did move)
+        // Points and beams never share maps.
+        s.photonBeams = !beams;
+        EXPECT_EQ(rendered(moved, s, cache)->stats().photonPassesReused, 0);
+    }
 }
 
 TEST(PhotonCache, MovingALightInvalidatesAndRendersAsAFreshRender) {
@@ -193,7 +200,8 @@ TEST(PhotonMapConsistency, KernelBiasFallsAsPhotonsAccumulate) {
     // the photon map's error against the path tracer (unbiased; 16 seeds) must fall: the kernel bias
     // goes as r^2, whose average over 64 passes of 1e4 photons is 0.42 of the first pass's with the
     // default alpha 0.7. Measured: -13% after 1 pass, -5.5% after 64 (errors 7.1e-3 and 2.9e-3,
-    // standard errors 5e-4 and 3e-4).
+    // standard errors 5e-4 and 3e-4). Beams (1D kernel, r shrinking as r (i+alpha)/(i+1)): -8.5% and
+    // -1.3%.
     SceneDesc d;
     auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(0.95), Spectrum(1.0), Spectrum(0.0), makeIsotropicPhase());
     d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
@@ -213,21 +221,24 @@ TEST(PhotonMapConsistency, KernelBiasFallsAsPhotonsAccumulate) {
         }
         return test::meanAndError(xs);
     };
-    RenderSettings pt = test::smallSettings(RenderSettings::Integrator::PathTracer, 256, 0);
+    RenderSettings pt = test::smallSettings(RenderSettings::Integrator::PathTracer, 128, 0);
     pt.width = pt.height = 4;
     auto ref = multiple(pt, 16);
-    RenderSettings pm = test::smallSettings(RenderSettings::Integrator::PhotonMap, 1, 0);
-    pm.width = pm.height = 4;
-    pm.photonsPerPass = 10000;
-    pm.initialRadius = 1.0;
-    auto few = multiple(pm, 16);
-    pm.samplesPerPixel = 64;
-    auto many = multiple(pm, 8);
-    double errFew = few.mean - ref.mean, errMany = many.mean - ref.mean;
-    std::printf("multiple: path tracer %.4f +- %.4f, photon map 1 pass %.4f +- %.4f, 64 passes %.4f +- %.4f\n", ref.mean,
-                ref.stderr_, few.mean, few.stderr_, many.mean, many.stderr_);
-    EXPECT_GT(std::abs(errFew), 4 * std::hypot(few.stderr_, ref.stderr_));  // the bias is there to see
-    EXPECT_LT(std::abs(errMany), 0.7 * std::abs(errFew));
+    for (bool beams : {false, true}) {
+        RenderSettings pm = test::smallSettings(RenderSettings::Integrator::PhotonMap, 1, 0);
+        pm.width = pm.height = 4;
+        pm.photonsPerPass = 10000;
+        pm.initialRadius = 1.0;
+        pm.photonBeams = beams;
+        auto few = multiple(pm, 16);
+        pm.samplesPerPixel = 64;
+        auto many = multiple(pm, 8);
+        double errFew = few.mean - ref.mean, errMany = many.mean - ref.mean;
+        std::printf("multiple: path tracer %.4f +- %.4f, photon %s 1 pass %.4f +- %.4f, 64 passes %.4f +- %.4f\n", ref.mean,
+                    ref.stderr_, beams ? "beams" : "points", few.mean, few.stderr_, many.mean, many.stderr_);
+        EXPECT_GT(std::abs(errFew), 4 * std::hypot(few.stderr_, ref.stderr_)) << "beams " << beams;  // the bias is there
+        EXPECT_LT(std::abs(errMany), 0.7 * std::abs(errFew)) << "beams " << beams;
+    }
 }
 
 }  // namespace volphoton

@@ -75,7 +75,7 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(intSetting("threads", 0, 4096, "--threads", "threadLimit", "Thread limit (0: all cores)", "",
                            "render threads; 0: all cores", &RS::threads));
     t.push_back(intSetting("photonsPerPass", 0, Big, "--photons", "volphoton:photonsPerPass", "Photons per pass (0: auto)", "",
-                           "photonMap: photons traced per pass (0: as many as cost two camera passes, in [4096, 1e6])", &RS::photonsPerPass));
+                           "photonMap: photons traced per pass (0: as many as cost one camera pass, in [4096, 1e6])", &RS::photonsPerPass));
     t.push_back(doubleSetting("initialRadius", 0, Big, "", "Initial photon radius (0: auto)", "scene units",
                               "photonMap: beam radius of pass 0 (0: 1/100 of the media's diameter)", &RS::initialRadius));
     t.push_back(doubleSetting("radiusAlpha", 1e-6, 1, "", "Photon radius reduction (alpha)", "",
@@ -84,6 +84,9 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(doubleSetting("photonRadiusMfp", 0, Big, "", "Photon radius cap (mean free paths)", "mean free paths",
                               "photonMap: a photon's radius is at most this many mean free paths (0: no cap)",
                               &RS::photonRadiusMfp));
+    t.push_back(boolSetting("photonBeams", "", "Photon beams",
+                            "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points",
+                            &RS::photonBeams));
     t.push_back(intSetting("stratifiedDims", 0, 4096, "", "volphoton:stratifiedDims", "Stratified dimensions (0: independent)",
                            "", "draws per camera sample taken from scrambled Sobol' points (0: independent)",
                            &RS::stratifiedDims));
