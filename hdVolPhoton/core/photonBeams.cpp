@@ -1,5 +1,7 @@
 #include "core/photonBeams.h"
 
+#include "core/embreeRay.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -86,20 +88,8 @@ void PhotonBeamMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<
     q.tMax = tMax;
     q.radius = radius_;
     q.visit = &visit;
-    RTCRayHit rh;
-    rh.ray.org_x = static_cast<float>(ray.o.x);
-    rh.ray.org_y = static_cast<float>(ray.o.y);
-    rh.ray.org_z = static_cast<float>(ray.o.z);
-    rh.ray.dir_x = static_cast<float>(ray.d.x);
-    rh.ray.dir_y = static_cast<float>(ray.d.y);
-    rh.ray.dir_z = static_cast<float>(ray.d.z);
     // Boxes are entered at most a radius before the closest point (float slack aside).
-    rh.ray.tnear = static_cast<float>(std::max(0.0, tMin - 2 * radius_));
-    rh.ray.tfar = std::isinf(tMax) ? std::numeric_limits<float>::infinity() : static_cast<float>(tMax + 2 * radius_);
-    rh.ray.mask = ~0u;
-    rh.ray.flags = 0;
-    rh.ray.time = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embreeRayHit(ray.o, ray.d, std::max(0.0, tMin - 2 * radius_), tMax + 2 * radius_);
     rtcIntersect1(scene_, &q.embree, &rh);
 }
 

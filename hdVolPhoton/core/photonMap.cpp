@@ -1,5 +1,7 @@
 #include "core/photonMap.h"
 
+#include "core/embreeRay.h"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -77,19 +79,7 @@ void PhotonMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<void
     // starts `back` behind the segment; the filter measures t from the real origin.
     const double back = 4 * radius_;
     Vec3 o = ray.o - ray.d * back;
-    RTCRayHit rh;
-    rh.ray.org_x = static_cast<float>(o.x);
-    rh.ray.org_y = static_cast<float>(o.y);
-    rh.ray.org_z = static_cast<float>(o.z);
-    rh.ray.dir_x = static_cast<float>(ray.d.x);
-    rh.ray.dir_y = static_cast<float>(ray.d.y);
-    rh.ray.dir_z = static_cast<float>(ray.d.z);
-    rh.ray.tnear = static_cast<float>(back + std::max(0.0, tMin - radius_));
-    rh.ray.tfar = std::isinf(tMax) ? std::numeric_limits<float>::infinity() : static_cast<float>(back + tMax + radius_);
-    rh.ray.mask = ~0u;
-    rh.ray.flags = 0;
-    rh.ray.time = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embreeRayHit(o, ray.d, back + std::max(0.0, tMin - radius_), back + tMax + radius_);
     rtcIntersect1(scene_, &ctx.embree, &rh);
 }
 

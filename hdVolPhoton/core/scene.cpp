@@ -1,5 +1,6 @@
 #include "core/scene.h"
 
+#include "core/embreeRay.h"
 #include "core/workCount.h"
 
 #include <sstream>
@@ -213,20 +214,7 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
         return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRayHit rh;
-    rh.ray.org_x = static_cast<float>(ray.o.x);
-    rh.ray.org_y = static_cast<float>(ray.o.y);
-    rh.ray.org_z = static_cast<float>(ray.o.z);
-    rh.ray.dir_x = static_cast<float>(ray.d.x);
-    rh.ray.dir_y = static_cast<float>(ray.d.y);
-    rh.ray.dir_z = static_cast<float>(ray.d.z);
-    rh.ray.tnear = static_cast<float>(tMin);
-    rh.ray.tfar = std::isinf(tMax) ? std::numeric_limits<float>::infinity() : static_cast<float>(tMax);
-    rh.ray.mask = ~0u;
-    rh.ray.flags = 0;
-    rh.ray.time = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embreeRayHit(ray.o, ray.d, tMin, tMax);
     rtcIntersect1(top_, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     int inst = static_cast<int>(rh.hit.instID[0]);

@@ -386,6 +386,17 @@ SceneDesc mediaOnlyScene() {
     return d;
 }
 
+/// A grey lambertian floor (albedo 0.7) under mediaOnlyScene's fog box.
+void addFloor(SceneDesc& d) {
+    MeshDesc floor;
+    floor.name = "floor";
+    floor.points = {Vec3(-4, -1.2, -4), Vec3(4, -1.2, -4), Vec3(4, -1.2, 4), Vec3(-4, -1.2, 4)};
+    floor.indices = {0, 2, 1, 0, 3, 2};
+    floor.material.albedo = Spectrum(0.7);
+    d.meshes.push_back(floor);
+    d.instances.push_back({static_cast<int>(d.meshes.size()) - 1, Affine()});
+}
+
 }  // namespace
 
 TEST(IntegratorAgreement, PhotonSinglePlusMultipleEqualsPathTracerBeauty) {
@@ -412,13 +423,7 @@ TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
     // Chromatic fog (spectral-tracking weights split beams), a distant and a sphere light, and a floor
     // (beams after a diffuse bounce): the beams' multiple scattering must match the path tracer's.
     SceneDesc d = mediaOnlyScene();
-    MeshDesc floor;
-    floor.name = "floor";
-    floor.points = {Vec3(-4, -1.2, -4), Vec3(4, -1.2, -4), Vec3(4, -1.2, 4), Vec3(-4, -1.2, 4)};
-    floor.indices = {0, 2, 1, 0, 3, 2};
-    floor.material.albedo = Spectrum(0.7);
-    d.meshes.push_back(floor);
-    d.instances.push_back({0, Affine()});
+    addFloor(d);
     RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
     RenderSettings beams = smallSettings(RenderSettings::Integrator::PhotonMap, 16, 0);
     beams.photonsPerPass = 4000;
@@ -441,13 +446,7 @@ TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     // A floor under a fog box: the floor sees light scattered by the fog, the fog sees light bounced
     // by the floor. Both integrators must agree on the whole image.
     SceneDesc d = mediaOnlyScene();
-    MeshDesc floor;
-    floor.name = "floor";
-    floor.points = {Vec3(-4, -1.2, -4), Vec3(4, -1.2, -4), Vec3(4, -1.2, 4), Vec3(-4, -1.2, 4)};
-    floor.indices = {0, 2, 1, 0, 3, 2};
-    floor.material.albedo = Spectrum(0.7);
-    d.meshes.push_back(floor);
-    d.instances.push_back({0, Affine()});
+    addFloor(d);
     d.camera = lookAt(Vec3(0.2, 1.5, 4.0), Vec3(0, -0.5, 0), 0.5);
     RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 16, 0);
     RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 8, 0);
