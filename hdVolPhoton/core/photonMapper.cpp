@@ -269,9 +269,17 @@ private:
                 if (q >= 1 || rng.uniform() < q) r.single += directExtended(p, ray.d, mp, stack, rng) * T * measure / q;
             }
         };
+        // The march serves volume emission, light sampling of lights with extent and transmittance
+        // without a closed form. With none of them (homogeneous or exponential media lit by point and
+        // spot lights: equiangular sampling below), only the media's support along the ray is needed.
+        const bool march = emissive || (single && hasExtended_) || !tr.closedForm;
         media.majorants(ray, 0.0, length, [&](const MajorantSegment& seg) {
             supportStart = std::min(supportStart, seg.tMin);
             supportEnd = std::max(supportEnd, seg.tMax);
+            if (!march) {
+                r.interacted |= seg.sigmaMaj > 0;
+                return true;
+            }
             // Steps of at most step_ that also resolve the local mean free path (a quarter of it,
             // from the majorant at the step's far end, so a ray descending into a steep exponential
             // atmosphere shortens its steps as the density grows); each step is sampled at the same
