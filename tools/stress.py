@@ -58,6 +58,7 @@ TESTENV = os.path.join(REPO, "testenv")
 PY = sys.executable
 
 CORE_ENV = "VOLPHOTON_STRESS_CORE"  # path of another build of volphoton._core (--core)
+BEAMS_ENV = "VOLPHOTON_STRESS_BEAMS"  # "1": the photon map's multiple scattering from beams (--photon-beams)
 
 
 def import_core():
@@ -464,6 +465,7 @@ def run_case(core, case, vdb_path, integrator, passes, size=(8, 6)):
             s.max_depth = depth
         s.threads = 1
         s.photons_per_pass = 2000
+        s.photon_beams = os.environ.get(BEAMS_ENV) == "1"
         s.integrator = (core.RenderSettings.Integrator.PhotonMap if integrator == "photonMap"
                         else core.RenderSettings.Integrator.PathTracer)
         r = core.Renderer(scene, s)
@@ -1113,6 +1115,8 @@ def main(argv=None) -> int:
     ap.add_argument("--strict", action="store_true", help="known issues (KNOWN_ISSUES) count as failures too")
     ap.add_argument("--core", help="test another build of volphoton._core (e.g. build-withvol/_core*.so) instead of "
                                    "the installed one; `volphoton render` cases use it too")
+    ap.add_argument("--photon-beams", action="store_true",
+                    help="photon-map cases estimate multiple scattering from photon beams (RenderSettings.photonBeams)")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--cases", default="", help=argparse.SUPPRESS)
     ap.add_argument("--vdb", default="", help=argparse.SUPPRESS)
@@ -1128,6 +1132,8 @@ def main(argv=None) -> int:
 
     if args.core:
         os.environ[CORE_ENV] = os.path.abspath(args.core)
+    if args.photon_beams:
+        os.environ[BEAMS_ENV] = "1"
     tmp = tempfile.mkdtemp(prefix="volphoton_stress_vdb_")
     vdb = os.path.join(tmp, "cloud.vdb")
     core = import_core()

@@ -15,14 +15,14 @@ struct BeamQuery {
     RTCIntersectContext embree;  // first member: Embree hands this pointer back to the callbacks
     const std::vector<PhotonBeam>* beams;
     const Ray* ray;
-    double tMin, tMax, radius;
+    double tMin, tMax;
     FunctionRef<void(const BeamHit&)>* visit;
 };
 
 void beamBounds(const RTCBoundsFunctionArguments* args) {
-    const auto* map = static_cast<const std::pair<const std::vector<PhotonBeam>*, float>*>(args->geometryUserPtr);
-    const PhotonBeam& b = (*map->first)[args->primID];
-    float r = map->second * 1.001f;  // float slack; the exact test is in beamIntersect
+    const auto* beams = static_cast<const std::vector<PhotonBeam>*>(args->geometryUserPtr);
+    const PhotonBeam& b = (*beams)[args->primID];
+    float r = b.radius * 1.001f;  // float slack; the exact test is in beamIntersect
     RTCBounds* out = args->bounds_o;
     float lo[3], hi[3];
     for (int c = 0; c < 3; ++c) {
@@ -49,7 +49,7 @@ void beamIntersect(const RTCIntersectFunctionNArguments* args) {
     double s = wr + t * dw;
     if (t < q->tMin || t > q->tMax || s < 0 || s > b.length) return;
     Vec3 gap = r0 + ray.d * t - w * s;
-    if (lengthSquared(gap) > q->radius * q->radius) return;
+    if (lengthSquared(gap) > double(b.radius) * b.radius) return;
     (*q->visit)(BeamHit{&b, t, s, std::sqrt(denom), -dw});
 }
 
@@ -59,11 +59,13 @@ PhotonBeamMap::PhotonBeamMap(std::vector<PhotonBeam> beams, double radius) : bea
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw std::runtime_error("cannot create an Embree device for the photon beams");
     scene_ = rtcNewScene(device_);
+    // Floor: a radius of 0 would divide by zero in the kernel (as PhotonMap).
+    const float rMax = static_cast<float>(radius), rMin = static_cast<float>(1e-6 * radius);
+    for (PhotonBeam& b : beams_) b.radius = std::isnan(b.radius) ? rMax : std::clamp(b.radius, rMin, rMax);
     if (!beams_.empty()) {
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
         rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(beams_.size()));
-        boundsData_ = {&beams_, static_cast<float>(radius_)};
-        rtcSetGeometryUserData(g, &boundsData_);
+        rtcSetGeometryUserData(g, &beams_);
         rtcSetGeometryBoundsFunction(g, beamBounds, nullptr);
         rtcSetGeometryIntersectFunction(g, beamIntersect);
         rtcCommitGeometry(g);
@@ -86,7 +88,6 @@ void PhotonBeamMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<
     q.ray = &ray;
     q.tMin = tMin;
     q.tMax = tMax;
-    q.radius = radius_;
     q.visit = &visit;
     // Boxes are entered at most a radius before the closest point (float slack aside).
     RTCRayHit rh = embreeRayHit(ray.o, ray.d, std::max(0.0, tMin - 2 * radius_), tMax + 2 * radius_);

@@ -35,6 +35,9 @@ struct PhotonBeam {
     float length;
     float power[3];  ///< flux along the beam (before any event at its end)
     int region;      ///< innermost medium mesh (-1: outside every mesh), as Photon::region
+    /// Kernel radius of this beam: the tracer stores a cap tied to the mean free path where the piece
+    /// ended (as Photon::radius); the map lowers it to the pass radius.
+    float radius;
 };
 
 /// What a query found: the beam and the closest points of the two lines.
@@ -58,8 +61,10 @@ public:
     PhotonBeamMap& operator=(const PhotonBeamMap&) = delete;
 
     /// Calls visit for every beam whose closest approach to the segment ray.o + t ray.d, t in
-    /// [tMin, tMax], lies within the radius, on the beam, and at such a t.
+    /// [tMin, tMax], lies within its radius (PhotonBeam::radius, at most radius()), on the beam, and
+    /// at such a t.
     void query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const BeamHit&)> visit) const;
+    /// The pass radius: the largest beam radius.
     double radius() const { return radius_; }
     size_t size() const { return beams_.size(); }
     size_t bytes() const { return beams_.size() * BytesPerBeam; }
@@ -69,7 +74,6 @@ public:
 private:
     std::vector<PhotonBeam> beams_;
     double radius_;
-    std::pair<const std::vector<PhotonBeam>*, float> boundsData_{nullptr, 0.0f};  ///< for Embree's bounds callback
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
 };

@@ -100,6 +100,7 @@ public:
         if (!tracePhotons(pass, photonsPerPass_, &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
         size_t stored, bytes;
         if (settings_.photonBeams) {
+            for (const PhotonBeam& b : records.beams) traced.radiusCapped += b.radius < r;
             traced.beams = std::make_shared<const PhotonBeamMap>(std::move(records.beams), r);
             beams_ = traced.beams;
             stored = beams_->size();
@@ -361,11 +362,17 @@ private:
         return f * T * ls.Li / (pick * ls.pdf);
     }
 
-    /// Equiangular sampling of [a, b] for a point light (Kulla and Fajardo 2012, eq. 6-7).
+    /// Equiangular sampling of [a, b], within what the light lights, for a point light (Kulla and
+    /// Fajardo 2012, eq. 6-7).
     Spectrum equiangular(int light, const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
                          const MediumStack& stack, Rng& rng) const {
-        if (!(b > a)) return {};
         const Light& L = *scene_.lights()[light];
+        // Only the part the light reaches (a spot's cone, Light::litInterval), as the path tracer does.
+        double lit0, lit1;
+        L.litInterval(ray, &lit0, &lit1);
+        a = std::max(a, lit0);
+        b = std::min(b, lit1);
+        if (!(b > a)) return {};
         Vec3 lp = *L.pointPosition();
         double delta = dot(lp - ray.o, ray.d);
         double D = length(lp - ray.at(delta));
@@ -427,10 +434,10 @@ private:
                          const MediumStack& stack) const {
         Spectrum sum;
         int region = stack.innermost();
-        double kernel = 1 / (2 * beams_->radius());
         beams_->query(ray, a, b, [&](const BeamHit& h) {
             const PhotonBeam& beam = *h.beam;
             if (beam.region != region) return;
+            double kernel = 1 / (2 * double(beam.radius));
             Vec3 x(beam.origin[0] + beam.dir[0] * h.sBeam, beam.origin[1] + beam.dir[1] * h.sBeam,
                    beam.origin[2] + beam.dir[2] * h.sBeam);
             Spectrum f = media.properties(x).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
@@ -542,7 +549,7 @@ private:
     /// scene's (a flight from a floor to a fog box, or out to an unbounded distance, has no beam
     /// outside them), as a beam carrying `flux`.
     void addBeamPiece(const Ray& ray, double t0, double t1, const Spectrum& flux, const Medium& media, int region,
-                      std::vector<PhotonBeam>* out) const {
+                      float radius, std::vector<PhotonBeam>* out) const {
         Bounds3 b = media.bounds(), box;
         box.lo = vmax(b.lo, sceneBox_.lo);
         box.hi = vmin(b.hi, sceneBox_.hi);
@@ -563,6 +570,7 @@ private:
         }
         beam.length = static_cast<float>(t1 - t0);
         beam.region = region;
+        beam.radius = radius;
         out->push_back(beam);
     }
 
@@ -600,12 +608,17 @@ private:
                 // Beams (photonBeams) of multiply scattered light: the flight in pieces of constant
                 // spectral weight, each ending where the flight or the weight changed (photonBeams.h).
                 const bool beams = out->wantBeams && events >= 1;
-                double pieceStart = 0;
+                double pieceStart = 0, sigmaMaj = 0;  // the majorant where the last piece ended
                 auto addBeam = [&](double t1) {
-                    if (beams) addBeamPiece(ray, pieceStart, t1, flux, media, stack.innermost(), &out->beams);
+                    int region = stack.innermost();
+                    // The mean-free-path cap, as for points (radiusCap), from the majorant at the
+                    // piece's end: beams in an opaque layer's skin are short, and so are their kernels.
+                    float cap = region < 0 ? radiusCap(sigmaMaj) : std::numeric_limits<float>::infinity();
+                    if (beams) addBeamPiece(ray, pieceStart, t1, flux, media, region, cap, &out->beams);
                     pieceStart = t1;
                 };
                 FlightEnd end = sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
+                    sigmaMaj = m.sigmaMaj;
                     Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
                     for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
                     double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
