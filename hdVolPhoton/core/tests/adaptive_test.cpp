@@ -175,7 +175,12 @@ TEST(Adaptive, AirlightStaysOnTheClosedForm) {
             xs.push_back(r.film().resolveRgb(Film::Single)[0]);
         }
         auto me = meanAndError(xs);
-        EXPECT_NEAR(me.mean, expected, 4 * me.stderr_);
+        // Plus the stopping rule's own bias (integrator.h: stopping on the pixel's estimate is not
+        // unbiased in the strict sense), 0.1% of the value: the photon map's single scattering here is
+        // equiangular sampling on Sobol'-stratified draws (no march: closed-form transmittance, a
+        // point light), whose spread across seeds is 0.007%; measured over 64 seeds: +0.046% with the
+        // 3% target, -0.02% +- 0.2% at a fixed 16 passes.
+        EXPECT_NEAR(me.mean, expected, 4 * me.stderr_ + 1e-3 * expected) << int(integrator);
         EXPECT_LT(me.stderr_, 0.03 / 2 * expected);  // 16 seeds of <= 3% each: ~0.75%
     }
 }
