@@ -465,7 +465,8 @@ def run_case(core, case, vdb_path, integrator, passes, size=(8, 6)):
             s.max_depth = depth
         s.threads = 1
         s.photons_per_pass = 2000
-        s.photon_beams = os.environ.get(BEAMS_ENV) == "1"
+        if os.environ.get(BEAMS_ENV) == "1":  # (an older --core has no such setting)
+            s.photon_beams = True
         s.integrator = (core.RenderSettings.Integrator.PhotonMap if integrator == "photonMap"
                         else core.RenderSettings.Integrator.PathTracer)
         r = core.Renderer(scene, s)
