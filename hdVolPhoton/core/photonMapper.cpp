@@ -553,14 +553,7 @@ private:
         Bounds3 b = media.bounds(), box;
         box.lo = vmax(b.lo, sceneBox_.lo);
         box.hi = vmin(b.hi, sceneBox_.hi);
-        for (int a = 0; a < 3; ++a) {
-            double inv = 1 / ray.d[a];
-            double n = (box.lo[a] - ray.o[a]) * inv, f = (box.hi[a] - ray.o[a]) * inv;
-            if (n > f) std::swap(n, f);
-            if (!std::isnan(n)) t0 = std::max(t0, n);
-            if (!std::isnan(f)) t1 = std::min(t1, f);
-        }
-        if (!(t1 > t0) || flux.isBlack()) return;
+        if (!box.intersect(ray, t0, t1, &t0, &t1) || !(t1 > t0) || flux.isBlack()) return;
         PhotonBeam beam;
         Vec3 o = ray.at(t0);
         for (int c = 0; c < 3; ++c) {
