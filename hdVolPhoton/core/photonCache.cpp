@@ -7,6 +7,8 @@
 
 namespace volphoton {
 
+size_t PhotonCache::Pass::size() const { return (map ? map->size() : 0) + (beams ? beams->size() : 0); }
+
 size_t PhotonCache::Pass::bytes() const { return (map ? map->bytes() : 0) + (beams ? beams->bytes() : 0); }
 
 bool PhotonCache::use(uint64_t key) {

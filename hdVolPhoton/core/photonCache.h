@@ -41,6 +41,7 @@ public:
         uint64_t traced = 0;         ///< photons traced for it
         uint64_t thinned = 0;        ///< photons the memory budget dropped
         uint64_t radiusCapped = 0;   ///< stored photons whose kernel the mean-free-path cap narrowed
+        size_t size() const;  ///< photons or beams stored
         size_t bytes() const;
     };
 

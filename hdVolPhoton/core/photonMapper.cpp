@@ -85,10 +85,9 @@ public:
             if (std::shared_ptr<const PhotonCache::Pass> kept = cache_->find(pass)) {
                 map_ = kept->map;
                 beams_ = kept->beams;
-                size_t n = map_ ? map_->size() : beams_ ? beams_->size() : 0;
                 stats.photonPassesReused += 1;
-                stats.photonsReused += n;
-                stats.photonsStored += n;
+                stats.photonsReused += kept->size();
+                stats.photonsStored += kept->size();
                 stats.photonsRadiusCapped += kept->radiusCapped;
                 stats.photonMapBytes = std::max(stats.photonMapBytes, kept->bytes());
                 return true;
@@ -98,25 +97,18 @@ public:
         records.wantBeams = settings_.photonBeams;
         PhotonCache::Pass traced;
         if (!tracePhotons(pass, photonsPerPass_, &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
-        size_t stored, bytes;
         if (settings_.photonBeams) {
             for (const PhotonBeam& b : records.beams) traced.radiusCapped += b.radius < r;
-            traced.beams = std::make_shared<const PhotonBeamMap>(std::move(records.beams), r);
-            beams_ = traced.beams;
-            stored = beams_->size();
-            bytes = beams_->bytes();
+            traced.beams = beams_ = std::make_shared<const PhotonBeamMap>(std::move(records.beams), r);
         } else {
             traced.radiusCapped = noteNarrowKernels(records.photons, r);
-            traced.map = std::make_shared<const PhotonMap>(std::move(records.photons), r);
-            map_ = traced.map;
-            stored = map_->size();
-            bytes = map_->bytes();
+            traced.map = map_ = std::make_shared<const PhotonMap>(std::move(records.photons), r);
         }
         stats.photonsTraced += traced.traced;
         stats.photonsThinned += traced.thinned;
         stats.photonsRadiusCapped += traced.radiusCapped;
-        stats.photonsStored += stored;
-        stats.photonMapBytes = std::max(stats.photonMapBytes, bytes);
+        stats.photonsStored += traced.size();
+        stats.photonMapBytes = std::max(stats.photonMapBytes, traced.bytes());
         if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes, scene_.desc().media);
         return true;
     }
