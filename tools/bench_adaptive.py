@@ -26,24 +26,14 @@ import platform
 
 import numpy as np
 
-from pxr import Usd
+from bench_load import load_bench_scene
 from volphoton import _core as core
-from volphoton import usdscene
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.join(REPO, "testenv", "bench")
 LUM = np.array([0.2126, 0.7152, 0.0722])
 
 
 def load(name, width, height):
-    path = os.path.join(BENCH, name + ".usda")
-    if "cloud" in name or "smoke" in name:
-        vdb = os.path.join(BENCH, "cloud.vdb")
-        if not os.path.exists(vdb):
-            core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)  # the benchmark's cloud (tools/bench/README.md)
-    stage = Usd.Stage.Open(path)
-    rs = usdscene.read_render_settings(stage)
-    tr = usdscene.translate(stage, Usd.TimeCode.EarliestTime(), width, height, rs.camera_path, rs.conform_policy)
+    rs, tr = load_bench_scene(name, width, height)
     settings = rs.settings
     settings.width, settings.height = width, height
     return core.Scene(tr.desc), settings

@@ -11,14 +11,11 @@ compares the two photon estimators and the beauty column the integrators.
 
 import argparse
 import math
-import os
 
 import numpy as np
-from pxr import Usd
-from volphoton import _core, usdscene
+from bench_load import load_bench_scene
+from volphoton import _core
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.join(REPO, "testenv", "bench")
 AOVS = ("beauty", "single", "multiple", "surface")
 
 
@@ -31,15 +28,10 @@ def main(argv=None):
     ap.add_argument("--photons", type=int, default=100000, help="photons per pass (0: automatic)")
     args = ap.parse_args(argv)
     w, h = args.resolution
-    vdb = os.path.join(BENCH, "cloud.vdb")
-    if not os.path.exists(vdb):
-        _core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)  # the benchmark's cloud
     print("| scene | estimator | passes | photons a pass | " + " | ".join("%s mean / RMSE" % a for a in AOVS) + " |")
     print("|---|---|---|---|" + "---|" * len(AOVS))
     for name in args.scenes.split(","):
-        stage = Usd.Stage.Open(os.path.join(BENCH, name + ".usda"))
-        rs = usdscene.read_render_settings(stage)
-        tr = usdscene.translate(stage, Usd.TimeCode.EarliestTime(), w, h, rs.camera_path, rs.conform_policy)
+        rs, tr = load_bench_scene(name, w, h)
         scene = _core.Scene(tr.desc)
 
         def run(kind, seconds, seed=0):

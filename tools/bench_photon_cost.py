@@ -13,13 +13,10 @@ and the RayCost that fits the measured balances best (least squares of the log r
 
 import argparse
 import math
-import os
 
-from pxr import Usd
-from volphoton import _core, usdscene
+from bench_load import load_bench_scene
+from volphoton import _core
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.join(REPO, "testenv", "bench")
 SCENES = ["homogeneous_cube", "vdb_cloud", "dense_cloud", "fog_spotlight", "atmosphere_sunset", "emissive_smoke"]
 
 
@@ -29,17 +26,12 @@ def main(argv=None):
     ap.add_argument("--passes", type=int, default=4)
     args = ap.parse_args(argv)
     w, h = args.resolution
-    vdb = os.path.join(BENCH, "cloud.vdb")
-    if not os.path.exists(vdb):
-        _core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)  # the benchmark's cloud
     print("| scene | ns per photon | ns per camera pixel-sample | photons per pixel for equal pass times "
           "| camera pass rays, lookups per pixel | photon rays, lookups | modelled photons per pixel | model / measured |")
     print("|---|---|---|---|---|---|---|---|")
     rows = []
     for name in SCENES:
-        stage = Usd.Stage.Open(os.path.join(BENCH, name + ".usda"))
-        rs = usdscene.read_render_settings(stage)
-        tr = usdscene.translate(stage, Usd.TimeCode.EarliestTime(), w, h, rs.camera_path, rs.conform_policy)
+        rs, tr = load_bench_scene(name, w, h)
         s = _core.RenderSettings()
         s.width, s.height, s.samples_per_pixel, s.max_depth = w, h, args.passes, rs.settings.max_depth
         s.integrator = _core.RenderSettings.Integrator.PhotonMap

@@ -13,14 +13,11 @@ noise left). Default settings otherwise (automatic photon count).
 
 import argparse
 import math
-import os
 
 import numpy as np
-from pxr import Usd
-from volphoton import _core, usdscene
+from bench_load import load_bench_scene
+from volphoton import _core
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BENCH = os.path.join(REPO, "testenv", "bench")
 SCENES = ["vdb_cloud", "fog_spotlight"]
 
 
@@ -44,15 +41,10 @@ def main(argv=None):
     ap.add_argument("--reference-passes", type=int, default=256)
     args = ap.parse_args(argv)
     w, h = args.resolution
-    vdb = os.path.join(BENCH, "cloud.vdb")
-    if not os.path.exists(vdb):
-        _core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)  # the benchmark's cloud
     print("| scene | view | passes, reuse | passes, from scratch | photon passes reused | RMSE reuse / from scratch |")
     print("|---|---|---|---|---|---|")
     for name in SCENES:
-        stage = Usd.Stage.Open(os.path.join(BENCH, name + ".usda"))
-        rs = usdscene.read_render_settings(stage)
-        tr = usdscene.translate(stage, Usd.TimeCode.EarliestTime(), w, h, rs.camera_path, rs.conform_policy)
+        rs, tr = load_bench_scene(name, w, h)
         base = tr.desc.camera.camera_to_world
         lo, hi = (np.array(v) for v in tr.bounds) if tr.bounds else (np.zeros(3), np.zeros(3))
         center = 0.5 * (lo + hi)
