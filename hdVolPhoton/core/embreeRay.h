@@ -1,11 +1,13 @@
-// The one conversion of a core ray to Embree's single-ray record (scene intersection, photon points,
-// photon beams).
+// Embree plumbing shared by the scene, the photon points and the photon beams: the one conversion of
+// a core ray to Embree's single-ray record, and a device with one scene owned together.
 #pragma once
 
 #include <embree3/rtcore.h>
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "core/math.h"
 
@@ -30,5 +32,35 @@ inline RTCRayHit embreeRayHit(const Vec3& o, const Vec3& d, double tNear, double
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     return rh;
 }
+
+/// \class EmbreeScene
+/// An Embree device with one scene, created together and released together (PhotonMap, PhotonBeamMap).
+class EmbreeScene {
+public:
+    /// `what` names the owner in the error thrown when Embree cannot make a device.
+    explicit EmbreeScene(const char* what) {
+        device_ = rtcNewDevice("verbose=0");
+        if (!device_) throw std::runtime_error(std::string("cannot create an Embree device for ") + what);
+        scene_ = rtcNewScene(device_);
+    }
+    ~EmbreeScene() {
+        if (scene_) rtcReleaseScene(scene_);
+        if (device_) rtcReleaseDevice(device_);
+    }
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+    RTCDevice device() const { return device_; }
+    RTCScene scene() const { return scene_; }
+    /// Commits g, attaches it to the scene and drops this reference to it.
+    void attach(RTCGeometry g) {
+        rtcCommitGeometry(g);
+        rtcAttachGeometry(scene_, g);
+        rtcReleaseGeometry(g);
+    }
+
+private:
+    RTCDevice device_ = nullptr;
+    RTCScene scene_ = nullptr;
+};
 
 }  // namespace volphoton

@@ -1,11 +1,10 @@
 #include "core/photonBeams.h"
 
-#include "core/embreeRay.h"
+#include "core/photonMap.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 namespace volphoton {
 
@@ -56,28 +55,16 @@ void beamIntersect(const RTCIntersectFunctionNArguments* args) {
 }  // namespace
 
 PhotonBeamMap::PhotonBeamMap(std::vector<PhotonBeam> beams, double radius) : beams_(std::move(beams)), radius_(radius) {
-    device_ = rtcNewDevice("verbose=0");
-    if (!device_) throw std::runtime_error("cannot create an Embree device for the photon beams");
-    scene_ = rtcNewScene(device_);
-    // Floor: a radius of 0 would divide by zero in the kernel (as PhotonMap).
-    const float rMax = static_cast<float>(radius), rMin = static_cast<float>(1e-6 * radius);
-    for (PhotonBeam& b : beams_) b.radius = std::isnan(b.radius) ? rMax : std::clamp(b.radius, rMin, rMax);
+    for (PhotonBeam& b : beams_) b.radius = kernelRadius(b.radius, radius);
     if (!beams_.empty()) {
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+        RTCGeometry g = rtcNewGeometry(embree_.device(), RTC_GEOMETRY_TYPE_USER);
         rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(beams_.size()));
         rtcSetGeometryUserData(g, &beams_);
         rtcSetGeometryBoundsFunction(g, beamBounds, nullptr);
         rtcSetGeometryIntersectFunction(g, beamIntersect);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(scene_, g);
-        rtcReleaseGeometry(g);
+        embree_.attach(g);
     }
-    rtcCommitScene(scene_);
-}
-
-PhotonBeamMap::~PhotonBeamMap() {
-    if (scene_) rtcReleaseScene(scene_);
-    if (device_) rtcReleaseDevice(device_);
+    rtcCommitScene(embree_.scene());
 }
 
 void PhotonBeamMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const BeamHit&)> visit) const {
@@ -91,7 +78,7 @@ void PhotonBeamMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<
     q.visit = &visit;
     // Boxes are entered at most a radius before the closest point (float slack aside).
     RTCRayHit rh = embreeRayHit(ray.o, ray.d, std::max(0.0, tMin - 2 * radius_), tMax + 2 * radius_);
-    rtcIntersect1(scene_, &q.embree, &rh);
+    rtcIntersect1(embree_.scene(), &q.embree, &rh);
 }
 
 }  // namespace volphoton

@@ -18,11 +18,9 @@
 // collision, a beam every camera ray within r of its whole flight (the fog of benchmark scene 4).
 #pragma once
 
-#include <embree3/rtcore.h>
-
-#include <utility>
 #include <vector>
 
+#include "core/embreeRay.h"
 #include "core/functionRef.h"
 #include "core/math.h"
 
@@ -56,9 +54,6 @@ struct BeamHit {
 class PhotonBeamMap {
 public:
     PhotonBeamMap(std::vector<PhotonBeam> beams, double radius);
-    ~PhotonBeamMap();
-    PhotonBeamMap(const PhotonBeamMap&) = delete;
-    PhotonBeamMap& operator=(const PhotonBeamMap&) = delete;
 
     /// Calls visit for every beam whose closest approach to the segment ray.o + t ray.d, t in
     /// [tMin, tMax], lies within its radius (PhotonBeam::radius, at most radius()), on the beam, and
@@ -74,8 +69,7 @@ public:
 private:
     std::vector<PhotonBeam> beams_;
     double radius_;
-    RTCDevice device_ = nullptr;
-    RTCScene scene_ = nullptr;
+    EmbreeScene embree_{"the photon beams"};
 };
 
 }  // namespace volphoton

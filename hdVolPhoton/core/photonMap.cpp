@@ -1,9 +1,6 @@
 #include "core/photonMap.h"
 
-#include "core/embreeRay.h"
-
 #include <algorithm>
-#include <stdexcept>
 
 namespace volphoton {
 
@@ -36,14 +33,9 @@ void gatherFilter(const RTCFilterFunctionNArguments* args) {
 }  // namespace
 
 PhotonMap::PhotonMap(std::vector<Photon> photons, double radius) : photons_(std::move(photons)), radius_(radius) {
-    device_ = rtcNewDevice("verbose=0");
-    if (!device_) throw std::runtime_error("cannot create an Embree device for the photon map");
-    scene_ = rtcNewScene(device_);
-    // Floor: a radius of 0 (a cap below float's range) would divide by zero in the kernel.
-    const float rMax = static_cast<float>(radius), rMin = static_cast<float>(1e-6 * radius);
-    for (Photon& ph : photons_) ph.radius = std::isnan(ph.radius) ? rMax : std::clamp(ph.radius, rMin, rMax);
+    for (Photon& ph : photons_) ph.radius = kernelRadius(ph.radius, radius);
     if (!photons_.empty()) {
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_DISC_POINT);
+        RTCGeometry g = rtcNewGeometry(embree_.device(), RTC_GEOMETRY_TYPE_DISC_POINT);
         float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), photons_.size()));
         for (size_t i = 0; i < photons_.size(); ++i) {
             v[4 * i] = photons_[i].p[0];
@@ -52,16 +44,9 @@ PhotonMap::PhotonMap(std::vector<Photon> photons, double radius) : photons_(std:
             v[4 * i + 3] = photons_[i].radius * 1.001f;  // float slack; the exact test is in the filter
         }
         rtcSetGeometryIntersectFilterFunction(g, gatherFilter);
-        rtcCommitGeometry(g);
-        rtcAttachGeometry(scene_, g);
-        rtcReleaseGeometry(g);
+        embree_.attach(g);
     }
-    rtcCommitScene(scene_);
-}
-
-PhotonMap::~PhotonMap() {
-    if (scene_) rtcReleaseScene(scene_);
-    if (device_) rtcReleaseDevice(device_);
+    rtcCommitScene(embree_.scene());
 }
 
 void PhotonMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<void(const Photon&, double, double)> visit) const {
@@ -80,7 +65,7 @@ void PhotonMap::query(const Ray& ray, double tMin, double tMax, FunctionRef<void
     const double back = 4 * radius_;
     Vec3 o = ray.o - ray.d * back;
     RTCRayHit rh = embreeRayHit(o, ray.d, back + std::max(0.0, tMin - radius_), back + tMax + radius_);
-    rtcIntersect1(scene_, &ctx.embree, &rh);
+    rtcIntersect1(embree_.scene(), &ctx.embree, &rh);
 }
 
 }  // namespace volphoton

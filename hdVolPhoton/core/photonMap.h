@@ -4,10 +4,11 @@
 // Mapping"). The intersection filter records each disc and rejects it so traversal goes on.
 #pragma once
 
-#include <embree3/rtcore.h>
-
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
+#include "core/embreeRay.h"
 #include "core/functionRef.h"
 #include "core/math.h"
 #include "core/phase.h"
@@ -29,14 +30,19 @@ struct Photon {
     float radius;
 };
 
+/// A stored kernel radius (a mean-free-path cap, or NaN for none) as a map uses it: at most the pass
+/// radius, at least 1e-6 of it (a radius of 0, a cap below float's range, would divide by zero in
+/// the kernel). PhotonMap and PhotonBeamMap.
+inline float kernelRadius(float stored, double passRadius) {
+    const float rMax = static_cast<float>(passRadius), rMin = static_cast<float>(1e-6 * passRadius);
+    return std::isnan(stored) ? rMax : std::clamp(stored, rMin, rMax);
+}
+
 /// \class PhotonMap
 /// Built once per pass from that pass's photons, then queried concurrently.
 class PhotonMap {
 public:
     PhotonMap(std::vector<Photon> photons, double radius);
-    ~PhotonMap();
-    PhotonMap(const PhotonMap&) = delete;
-    PhotonMap& operator=(const PhotonMap&) = delete;
 
     /// Calls visit(photon, t along the ray, squared distance to the ray) for every photon whose own
     /// radius (Photon::radius, at most radius()) reaches the segment ray.o + t ray.d, t in [tMin, tMax].
@@ -52,8 +58,7 @@ public:
 private:
     std::vector<Photon> photons_;
     double radius_;
-    RTCDevice device_ = nullptr;
-    RTCScene scene_ = nullptr;
+    EmbreeScene embree_{"the photon map"};
 };
 
 }  // namespace volphoton
