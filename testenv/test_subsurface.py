@@ -193,6 +193,13 @@ def test_iadpython_reproduces_the_references():
         ur1, ut1, _, _ = s.rt()
         assert ur1 - SPECULAR == pytest.approx(expected, abs=5e-5), a
         assert ut1 < 1e-9
+    sigma_t, albedo = marble_coefficients()
+    for c, expected in enumerate(MARBLE_REFLECTANCE):
+        s = iadpython.Sample(a=albedo[c], b=sigma_t[c] * MARBLE_D, g=0.0, n=IOR, n_above=1.0, n_below=1.0,
+                             quad_pts=16)
+        ur1, ut1, _, _ = s.rt()
+        assert ur1 - SPECULAR == pytest.approx(expected, abs=5e-5), c
+        assert ut1 < 1e-7
 
 
 # Geometry, in mean free paths (sigma_t = 1): a box 2H x 2H x D with its top face at z = 0, seen
@@ -287,6 +294,56 @@ def test_slab_reflectance_matches_the_transport_solution(integrator, albedo):
     # The test has teeth: the tolerance stays below 6 % of the reference (leaving out the 1/eta^2
     # radiance scaling, or Fresnel at the exit, changes R by far more).
     assert 4 * sigma + allowance < 0.06 * ref, sigma
+
+
+# The marble of benchmark scene 9 (Jensen et al. 2001, Table 2, g = 0; the "marble" preset): strongly
+# chromatic extinction (red 0.73 of blue) and albedo 0.998-0.999, so walks take hundreds of events and
+# the per-channel weights of chromatic distance sampling matter.  Lengths in blue mean free paths; a
+# slab MARBLE_D deep (the red channel's diffusion length is 26 of them: T < 4e-8).  Per channel, total
+# reflectance for normal incidence minus the specular term, iadpython 0.5.3 (quad_pts=16; 32 points
+# move them by 1e-4).  This is the independent check of issue 16 part 4: the figurine's mean differed
+# from Mitsuba's by 2.2 %; measured here: path tracer 0.87611 +- 0.00106, 0.84552 +- 0.00092,
+# 0.81441 +- 0.00136 with the specular term (64 x 64 px, 16 seeds x 16 passes) against iadpython's
+# 0.87632, 0.84550, 0.81440.  (`python tools/bench/check_marble_slab.py` puts Mitsuba beside it.)
+MARBLE_D = 400.0
+MARBLE_REFLECTANCE = (0.85930, 0.82849, 0.79738)
+
+
+def marble_coefficients():
+    """(sigma_t relative to the largest channel, albedo) of the marble preset with g = 0."""
+    ssp, sa = presets.PRESETS["marble"]
+    st = np.array(ssp) + np.array(sa)
+    return st / st.max(), np.array(ssp) / st
+
+
+def test_marble_slab_matches_the_transport_solution_per_channel():
+    sigma_t, albedo = marble_coefficients()
+    d = _core.SceneDesc()
+    coeffs = _core.MediumCoefficients.from_albedo(1.0, tuple(sigma_t), tuple(albedo), (0, 0, 0),
+                                                  _core.isotropic_phase())
+    medium = d.add_medium(_core.HomogeneousMedium(coeffs), False)
+    glass = _core.SurfaceMaterial(kind=_core.SurfaceMaterial.Kind.Dielectric, ior=IOR)
+    mesh = d.add_mesh(box_mesh((-SLAB_H, -SLAB_H, -MARBLE_D), (SLAB_H, SLAB_H, 0.0), glass, medium))
+    d.add_instance(mesh, np.eye(4))
+    d.add_light(_core.dome_light((1, 1, 1)))
+    cam = _core.CameraDesc()
+    cam.projection = _core.CameraDesc.Projection.Orthographic
+    cam.ortho_width = SLAB_VIEW
+    to_world = np.eye(4)
+    to_world[2, 3] = 10.0
+    cam.camera_to_world = to_world
+    d.camera = cam
+    s = _core.RenderSettings()  # the defaults: in particular maxDepth and roulette
+    s.integrator = integrator_enum("pathTracer")
+    s.width = s.height = 64
+    s.samples_per_pixel = 16
+    images = pass_images(_core.Scene(d), s, tuple(range(6)))
+    r, sigma = mean_sigma(images.mean(axis=(1, 2)) - SPECULAR)
+    ref = np.array(MARBLE_REFLECTANCE)
+    tol = 4 * sigma + PT_ALLOWANCE * ref
+    assert np.all(np.abs(r - ref) <= tol), (r, sigma, ref)
+    # Teeth: the tolerance stays below the 2.2 % by which Mitsuba's volpath differed on the figurine.
+    assert np.all(tol < 0.02 * ref), tol
 
 
 def test_wide_slab_tracks_the_medium_from_the_surface():
