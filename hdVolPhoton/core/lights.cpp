@@ -93,6 +93,7 @@ std::pair<Vec3, double> upstreamPoint(const PhotonAim& aim, const Vec3& dir, dou
 
 class DistantLight final : public Light {
 public:
+    std::optional<Bounds3> extent() const override { return std::nullopt; }
     DistantLight(const Vec3& dir, double halfAngle, const Spectrum& E) : dir_(normalize(dir)), E_(E) {
         requireFinite(E, "distant light");
         if (!isFinite(dir) || length(dir) == 0) throw std::invalid_argument("distant light: direction must be non-zero");
@@ -142,6 +143,12 @@ private:
 
 class SphereLight final : public Light {
 public:
+    std::optional<Bounds3> extent() const override {
+        Bounds3 b;
+        b.extend(p_ - Vec3(r_, r_, r_));
+        b.extend(p_ + Vec3(r_, r_, r_));
+        return b;
+    }
     SphereLight(const Vec3& p, double radius, const Spectrum& L, const Vec3& axis, double coneAngle, double softness)
         : p_(p), r_(std::max(0.0, radius)), L_(L), axis_(axis), cone_(coneAngle), softness_(softness) {
         requireFinite(L, "sphere light");
@@ -242,6 +249,12 @@ private:
 /// Rect and disk: planar one-sided emitters facing local -Z.
 class PlanarLight final : public Light {
 public:
+    std::optional<Bounds3> extent() const override {
+        Bounds3 b;  // the disk's bounding parallelogram, the rect's corners
+        for (double x : {-1.0, 1.0})
+            for (double y : {-1.0, 1.0}) b.extend(center_ + ex_ * x + ey_ * y);
+        return b;
+    }
     PlanarLight(const Affine& toWorld, bool disk, double sx, double sy, const Spectrum& L) : disk_(disk), L_(L) {
         requireFinite(L, disk ? "disk light" : "rect light");
         if (!(sx > 0) || !(sy > 0)) throw std::invalid_argument(std::string(disk ? "disk" : "rect") + " light: size must be positive");
@@ -310,6 +323,11 @@ private:
 
 class MeshLight final : public Light {
 public:
+    std::optional<Bounds3> extent() const override {
+        Bounds3 b;
+        for (const Vec3& p : points_) b.extend(p);
+        return b;
+    }
     MeshLight(std::string name, std::vector<Vec3> points, const std::vector<uint32_t>& indices, const Spectrum& L)
         : name_(std::move(name)), points_(std::move(points)), L_(L) {
         requireFinite(L, "mesh light");
@@ -390,6 +408,7 @@ private:
 
 class DomeLight final : public Light {
 public:
+    std::optional<Bounds3> extent() const override { return std::nullopt; }
     DomeLight(const Spectrum& L, LatLongImage img, const Affine& toWorld) : L_(L), img_(std::move(img)), toWorld_(toWorld) {
         requireFinite(L, "dome light");
         auto inv = toWorld.inverse();

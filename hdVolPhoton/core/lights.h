@@ -95,6 +95,9 @@ public:
         (void)ref, (void)p, (void)n;
         return 0;
     }
+    /// Box holding every point that emits (a sphere light's ball, a rect's corners, a mesh light's
+    /// points); nullopt for lights at infinity (distant, dome). Scene::sealedFromLights reads it.
+    virtual std::optional<Bounds3> extent() const = 0;
     virtual std::string describe() const = 0;
 };
 

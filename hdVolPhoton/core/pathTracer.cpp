@@ -116,8 +116,8 @@ public:
                 if (firstVertex) branch = Branch::Medium;
                 const MediumProperties& mp = scatter.mp;
                 Vec3 p = scatter.p;
-                // Next-event estimation.
-                DirectSample ds = sampleDirect(p, rng);
+                // Next-event estimation (none inside a dielectric that no shadow ray can leave).
+                DirectSample ds = scene_.sealedFromLights(stack) ? DirectSample{} : sampleDirect(p, rng);
                 if (ds.light >= 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack()) {
                     double cosTheta = dot(ray.d, ds.ls.wi);
                     Spectrum f = mp.scatterKernel(cosTheta);

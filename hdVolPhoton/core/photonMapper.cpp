@@ -241,7 +241,8 @@ private:
         tr.ray = &ray;
         tr.closedForm = static_cast<bool>(media.opticalDepth(ray, 0.0, 0.0));
         bool emissive = media.isEmissive();
-        bool single = settings_.singleScattering;
+        // No light sampling inside a dielectric that no shadow ray can leave (Scene::sealedFromLights).
+        bool single = settings_.singleScattering && !scene_.sealedFromLights(stack);
         double weight = 1.0;  // Russian-roulette weight of the march's early termination
         Spectrum tauRun;      // marched optical depth so far
         double supportStart = Infinity, supportEnd = 0;

@@ -144,6 +144,23 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     }
     rtcCommitScene(top_);
     addMeshLights();
+    // Closed dielectric meshes with no light inside their bounds: a shadow ray from inside one must
+    // cross its surface, where shadow rays stop (a refracting surface passes no straight line).
+    sealed_.assign(desc_.meshes.size(), 0);
+    for (size_t mi = 0; mi < desc_.meshes.size(); ++mi) {
+        if (!meshClosed_[mi] || desc_.meshes[mi].material.kind != SurfaceMaterial::Kind::Dielectric) continue;
+        const Bounds3& mb = meshBounds_[mi];
+        if (mb.empty()) continue;
+        bool lightInside = false;
+        for (const LightPtr& l : desc_.lights) {
+            std::optional<Bounds3> e = l->extent();
+            if (!e) continue;  // at infinity
+            bool apart = e->hi.x < mb.lo.x || e->lo.x > mb.hi.x || e->hi.y < mb.lo.y || e->lo.y > mb.hi.y ||
+                         e->hi.z < mb.lo.z || e->lo.z > mb.hi.z;
+            lightInside |= !apart;
+        }
+        sealed_[mi] = !lightInside;
+    }
 
     // The media's own box too (volumes with bounds, media inside meshes): none when one is unbounded.
     Bounds3 media;

@@ -131,6 +131,14 @@ public:
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
     /// Whether mesh i is topologically closed (every edge shared by exactly two triangles).
     bool meshClosed(int i) const { return meshClosed_[i] != 0; }
+    /// Whether no light can be reached by a straight shadow ray from a point inside the meshes of
+    /// `stack`: one of them is a closed dielectric (shadow rays stop at it) with no light's extent
+    /// overlapping its bounds. Next-event estimation there always returns zero and is skipped.
+    bool sealedFromLights(const MediumStack& stack) const {
+        for (int i = 0; i < stack.size; ++i)
+            if (sealed_[stack.mesh[i]]) return true;
+        return false;
+    }
     /// The SceneDesc's lights, then one mesh light per instance of an emissive lambertian mesh.
     const std::vector<LightPtr>& lights() const { return desc_.lights; }
     /// Index in lights() of instance i's mesh light, or -1 when the instance does not emit.
@@ -189,6 +197,7 @@ private:
     Vec3 mediaCenter_;
     double mediaRadius_ = 0;
     std::vector<char> meshClosed_;
+    std::vector<char> sealed_;  ///< closed dielectric meshes with no light inside (sealedFromLights)
     std::vector<int> instanceLight_;  ///< per instance: index of its mesh light in lights(), or -1
 
     void addMeshLights();

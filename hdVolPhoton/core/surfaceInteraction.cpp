@@ -20,6 +20,7 @@ double fresnelDielectric(double cosI, double eta) {
 Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng,
                                         bool mis) const {
     const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
+    if (scene_.sealedFromLights(stack)) return {};  // inside a dielectric no shadow ray can leave
     DirectSample ds = sampleDirect(hit.p, rng);
     Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
     double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;

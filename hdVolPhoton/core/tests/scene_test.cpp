@@ -428,3 +428,57 @@ TEST(Scene, WarnsWhenMoreMediaOverlapThanAreRendered) {
     for (const std::string& m : messages) warned |= m.find("are ignored") != std::string::npos;
     EXPECT_TRUE(warned);
 }
+
+TEST(SceneLights, DielectricsWithNoLightInsideAreSealedFromNextEventEstimation) {
+    // Shadow rays stop at dielectric surfaces, so from inside a closed dielectric no light outside
+    // it can be sampled: the integrators skip next-event estimation there (Scene::sealedFromLights).
+    // A light whose extent overlaps the mesh's bounds, an open mesh or a boundary mesh must not seal.
+    auto box = [](const std::string& name, double h) {  // closed: every edge in two triangles
+        MeshDesc m;
+        m.name = name;
+        for (int i = 0; i < 8; ++i) m.points.push_back(Vec3(i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h));
+        m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                     2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+        return m;
+    };
+    auto scene = [&](std::vector<LightPtr> lights, bool emissiveInside) {
+        SceneDesc d;
+        d.meshes.push_back(box("glass", 1.0));
+        d.meshes[0].material.kind = SurfaceMaterial::Kind::Dielectric;
+        d.meshes.push_back(box("boundary", 1.0));
+        d.meshes[1].material.kind = SurfaceMaterial::Kind::Boundary;
+        d.meshes.push_back(box("open", 1.0));
+        d.meshes[2].material.kind = SurfaceMaterial::Kind::Dielectric;
+        d.meshes[2].indices.resize(d.meshes[2].indices.size() - 6);  // a hole
+        d.instances.push_back({0, Affine()});
+        d.instances.push_back({1, Affine::translate(Vec3(5, 0, 0))});
+        d.instances.push_back({2, Affine::translate(Vec3(-5, 0, 0))});
+        if (emissiveInside) {
+            d.meshes.push_back(box("ember", 0.1));
+            d.meshes[3].material.emission = Spectrum(1.0);
+            d.instances.push_back({3, Affine::translate(Vec3(0.2, 0, 0))});
+        }
+        d.lights = std::move(lights);
+        d.camera.cameraToWorld = lookAtCamera(Vec3(0, 0, 10));
+        return std::make_unique<Scene>(std::move(d));
+    };
+    auto sealed = [](const Scene& s, int mesh) {
+        MediumStack stack;
+        stack.toggle(mesh);
+        return s.sealedFromLights(stack);
+    };
+    std::vector<LightPtr> far = {makeDomeLight(Spectrum(1.0)), makeDistantLight(Vec3(0, -1, 0), 0.0, Spectrum(1.0)),
+                                 makeSphereLight(Vec3(0, 3, 0), 0.5, Spectrum(1.0))};
+    auto s = scene(far, false);
+    EXPECT_TRUE(sealed(*s, 0));
+    EXPECT_FALSE(sealed(*s, 1));
+    EXPECT_FALSE(sealed(*s, 2));
+    EXPECT_FALSE(s->sealedFromLights(MediumStack{}));
+    MediumStack nested;  // a boundary nested in the glass: still sealed
+    nested.toggle(0);
+    nested.toggle(1);
+    EXPECT_TRUE(s->sealedFromLights(nested));
+    EXPECT_FALSE(sealed(*scene({makeSphereLight(Vec3(0, 1.2, 0), 0.3, Spectrum(1.0))}, false), 0));  // overlaps
+    EXPECT_FALSE(sealed(*scene({makeSphereLight(Vec3(0, 0, 0), 0.0, Spectrum(1.0))}, false), 0));    // inside
+    EXPECT_FALSE(sealed(*scene(far, true), 0));  // an emissive mesh inside is a light inside
+}
