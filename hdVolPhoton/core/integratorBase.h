@@ -131,6 +131,13 @@ protected:
     DirectSample sampleDirect(const Vec3& p, Rng& rng) const;
     /// Probability that sampleDirect() picks light i times the light's own solid-angle density.
     double lightPickProb(int light) const { return lightDist_.size() ? lightDist_.discretePdf(light) : 0.0; }
+    /// Lambertian vertices sample every light (one sample and shadow ray each) instead of picking one
+    /// by power when the scene has at most this many: picking one of a sun and a sky had 5x the
+    /// per-sample variance of the two lights' separate renders on benchmark scene 7 (issue 16).
+    static constexpr size_t AllLightsMax = 4;
+    bool surfaceSamplesAllLights() const { return scene_.lights().size() <= AllLightsMax; }
+    /// Probability with which a lambertian vertex's next-event estimation chooses light i (for MIS).
+    double surfaceLightPickProb(int light) const { return surfaceSamplesAllLights() ? 1.0 : lightPickProb(light); }
     /// Nearest light with extent hit by ray before tMax (including escape to dome/distant lights).
     /// The nearest light the ray meets before tMax. cameraRay: the ray is still the camera's own (first
     /// segment), so a dome hidden by RenderSettings::domeVisibleToCamera is not met.
@@ -141,16 +148,17 @@ protected:
     Spectrum shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng,
                                  double tMin = 0) const;
     /// Next-event estimate at a lambertian hit for a path arriving along ray.d: albedo/pi cos T Li / pdf
-    /// for one light picked by power. With `mis`, lights with extent are weighted by the power
+    /// for every light (surfaceSamplesAllLights) or one light picked by power. With `mis`, lights with extent are weighted by the power
     /// heuristic against cosine sampling (the path tracer); without, light sampling stands alone.
     Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
     /// Radiance an emissive lambertian surface sends back along ray.d (from its front face, the side
     /// hit.ng points to), else black. The camera paths add it at their hits (weighted: emissive
     /// meshes are lights too, Scene::instanceLight).
     Spectrum surfaceEmission(const Ray& ray, const SurfaceHit& hit) const;
-    /// Density (pick probability times solid angle) with which sampleDirect() from `from` produces
-    /// the emitter point of `hit`: 0 when the hit's instance is not a mesh light. For MIS at hits.
-    double emitterDensity(const Vec3& from, const SurfaceHit& hit) const;
+    /// Density (pick probability times solid angle) with which next-event estimation from `from` (a
+    /// lambertian vertex when fromSurface, else a medium vertex) produces the emitter point of `hit`:
+    /// 0 when the hit's instance is not a mesh light. For MIS at hits.
+    double emitterDensity(const Vec3& from, const SurfaceHit& hit, bool fromSurface) const;
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
     /// The surface, light and hole a camera path meets next along path.ray (surfaces in [tMin, tMax];

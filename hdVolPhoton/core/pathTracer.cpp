@@ -47,6 +47,7 @@ public:
         bool specular = true;  // the previous vertex cannot be light-sampled (camera, mirror, refraction)
         double prevPdf = 0;
         Vec3 prevVertex;  // the last scattering vertex (for the light-sampling density of emitter hits)
+        bool prevSurface = false;  // that vertex is a surface's (whose next-event estimation samples every light)
         int depth = 0, crossings = 0;
         bool firstSegment = true;
         bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
@@ -144,6 +145,7 @@ public:
                 beta *= mp.scatterKernel(cosTheta) / pdf;
                 prevPdf = pdf;
                 prevVertex = p;
+                prevSurface = false;
                 specular = false;
                 path.bounce({p, w}, 0.0);
                 firstSegment = false;
@@ -159,7 +161,8 @@ public:
             lightHitIsSingle = false;
             // Reached a light, a surface, or escaped.
             if (ahead.reachesLight()) {
-                double w = specular ? 1.0 : powerHeuristic(prevPdf, lightPickProb(ahead.light) * ahead.lightPdf);
+                double pick = prevSurface ? surfaceLightPickProb(ahead.light) : lightPickProb(ahead.light);
+                double w = specular ? 1.0 : powerHeuristic(prevPdf, pick * ahead.lightPdf);
                 add(beta * ahead.lightLe * w, lightWasSingle);
                 if (firstSegment && !std::isinf(ahead.tLight)) out.alpha = 1;
                 break;
@@ -170,7 +173,7 @@ public:
             // previous vertex (power heuristic), as lights with extent are above.
             Spectrum Le = surfaceEmission(ray, ahead.hit);
             if (!Le.isBlack()) {
-                double w = specular ? 1.0 : powerHeuristic(prevPdf, emitterDensity(prevVertex, ahead.hit));
+                double w = specular ? 1.0 : powerHeuristic(prevPdf, emitterDensity(prevVertex, ahead.hit, prevSurface));
                 add(beta * Le * w, lightWasSingle);
             }
             // Surface light goes to `surface` when the surface is the first vertex (branch Undecided
@@ -184,6 +187,7 @@ public:
             specular = s.type == SurfaceScatter::Type::Specular;
             if (!specular) prevPdf = std::abs(dot(s.next.d, ahead.hit.ns)) * InvPi;
             prevVertex = ahead.hit.p;
+            prevSurface = true;
             firstSegment = false;
             if (!roulette(beta, depth, rng)) break;
         }

@@ -21,15 +21,26 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
                                         bool mis) const {
     const SurfaceMaterial& m = scene_.mesh(hit.mesh).material;
     if (scene_.sealedFromLights(stack)) return {};  // inside a dielectric no shadow ray can leave
-    DirectSample ds = sampleDirect(hit.p, rng);
     Vec3 n = dot(-ray.d, hit.ns) >= 0 ? hit.ns : -hit.ns;
-    double cosL = ds.light >= 0 ? dot(ds.ls.wi, n) : 0;
-    // The light must be on the viewer's side of the geometric surface too (no light leaks through).
-    if (!(cosL > 0) || !(ds.ls.pdf > 0) || ds.ls.Li.isBlack() || dot(ds.ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
-    Spectrum T = shadowTransmittance(hit.p, ds.ls.wi, ds.ls.dist, stack, rng, scene_.spawnTMin(hit, ds.ls.wi));
-    double lightDensity = ds.pickProb * ds.ls.pdf;
-    double w = mis && !ds.ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
-    return m.albedo * (cosL * InvPi) * T * ds.ls.Li * (w / lightDensity);
+    auto estimate = [&](const LightSample& ls, double pickProb) -> Spectrum {
+        double cosL = dot(ls.wi, n);
+        // The light must be on the viewer's side of the geometric surface too (no light leaks through).
+        if (!(cosL > 0) || !(ls.pdf > 0) || ls.Li.isBlack() || dot(ls.wi, hit.ng) * dot(-ray.d, hit.ng) <= 0) return {};
+        Spectrum T = shadowTransmittance(hit.p, ls.wi, ls.dist, stack, rng, scene_.spawnTMin(hit, ls.wi));
+        double lightDensity = pickProb * ls.pdf;
+        double w = mis && !ls.isDelta ? powerHeuristic(lightDensity, cosL * InvPi) : 1.0;
+        return m.albedo * (cosL * InvPi) * T * ls.Li * (w / lightDensity);
+    };
+    if (surfaceSamplesAllLights()) {
+        Spectrum sum;
+        for (const LightPtr& light : scene_.lights()) {
+            auto [u1, u2] = rng.uniform2();
+            sum += estimate(light->sample(hit.p, u1, u2), 1.0);
+        }
+        return sum;
+    }
+    DirectSample ds = sampleDirect(hit.p, rng);
+    return ds.light >= 0 ? estimate(ds.ls, ds.pickProb) : Spectrum();
 }
 
 SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng,
@@ -91,9 +102,11 @@ Spectrum Integrator::surfaceEmission(const Ray& ray, const SurfaceHit& hit) cons
     return m.emission;
 }
 
-double Integrator::emitterDensity(const Vec3& from, const SurfaceHit& hit) const {
+double Integrator::emitterDensity(const Vec3& from, const SurfaceHit& hit, bool fromSurface) const {
     int light = scene_.instanceLight(hit.instance);
-    return light < 0 ? 0.0 : lightPickProb(light) * scene_.lights()[light]->pdfAt(from, hit.p, hit.ng);
+    if (light < 0) return 0.0;
+    double pick = fromSurface ? surfaceLightPickProb(light) : lightPickProb(light);
+    return pick * scene_.lights()[light]->pdfAt(from, hit.p, hit.ng);
 }
 
 SurfaceStep Integrator::cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, MediumStack& stack, Spectrum& beta,

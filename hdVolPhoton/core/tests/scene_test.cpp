@@ -482,3 +482,36 @@ TEST(SceneLights, DielectricsWithNoLightInsideAreSealedFromNextEventEstimation) 
     EXPECT_FALSE(sealed(*scene({makeSphereLight(Vec3(0, 0, 0), 0.0, Spectrum(1.0))}, false), 0));    // inside
     EXPECT_FALSE(sealed(*scene(far, true), 0));  // an emissive mesh inside is a light inside
 }
+
+TEST(SceneLights, EveryLightOrOnePickedAtSurfacesGivesTheExactDirectIrradiance) {
+    // A lambertian floor (albedo 0.5) under two spherical lights, direct light only: the radiance
+    // leaving the floor at the origin is albedo/pi x sum of pi L (r/d)^2 cos(theta) (a sphere wholly
+    // above the horizon). Two lights: a lambertian vertex samples both (surfaceSamplesAllLights);
+    // with three more lights that send nothing upwards it picks one of five by power. Either way
+    // the MIS weights against cosine sampling must sum to one: the path tracer weighs its light
+    // hits with the pick probability of the vertex they came from (the power-heuristic pick there:
+    // +14.6%).
+    for (int extraLights : {0, 3}) {
+        SceneDesc d;
+        MeshDesc floor;
+        floor.name = "floor";
+        floor.points = {Vec3(-20, 0, -20), Vec3(20, 0, -20), Vec3(20, 0, 20), Vec3(-20, 0, 20)};
+        floor.indices = {0, 2, 1, 0, 3, 2};
+        d.meshes.push_back(floor);
+        d.instances.push_back({0, Affine()});
+        // Large lights, so that cosine sampling finds them often and the MIS weights matter.
+        d.lights.push_back(makeSphereLight(Vec3(0, 3, 0), 2.0, Spectrum(1.0)));
+        d.lights.push_back(makeSphereLight(Vec3(4, 3, 0), 1.5, Spectrum(1.0)));
+        for (int i = 0; i < extraLights; ++i) d.lights.push_back(makeDistantLight(Vec3(0, 1, 0), 0.0, Spectrum(0.01)));
+        d.camera = test::lookAt(Vec3(0, 0.5, 0), Vec3(0, 0, 0));
+        d.camera.projection = CameraDesc::Projection::Orthographic;
+        d.camera.orthoWidth = 0.01;
+        RenderSettings s = test::smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+        s.width = s.height = 4;
+        s.maxDepth = 1;
+        double expected = 0.5 * (4.0 / 9.0 + 2.25 / 25.0 * 0.6);
+        auto m = test::imageMean(d, s, [](const Film& f) { return test::aovMean(f, Film::Beauty); });
+        EXPECT_NEAR(m.mean, expected, 4 * m.stderr_ + 0.003 * expected) << extraLights << " extra lights, +- " << m.stderr_;
+        EXPECT_LT(4 * m.stderr_, 0.01 * expected) << extraLights << " extra lights, mean " << m.mean;  // resolves a 1% bias
+    }
+}
