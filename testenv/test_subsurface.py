@@ -239,9 +239,11 @@ def box_mesh(lo, hi, material, medium):
     return m
 
 
-def slab_scene(albedo, depth=SLAB_D, half=SLAB_H, view=SLAB_VIEW):
+def slab_scene(albedo, depth=SLAB_D, half=SLAB_H, view=SLAB_VIEW, sigma_t=(1, 1, 1)):
+    """albedo: grey (a number) or per channel; sigma_t per channel, in the slab's length units."""
     d = _core.SceneDesc()
-    coeffs = _core.MediumCoefficients.from_albedo(1.0, (1, 1, 1), (albedo,) * 3, (0, 0, 0), _core.isotropic_phase())
+    albedo = tuple(albedo) if np.ndim(albedo) else (albedo,) * 3
+    coeffs = _core.MediumCoefficients.from_albedo(1.0, tuple(sigma_t), albedo, (0, 0, 0), _core.isotropic_phase())
     medium = d.add_medium(_core.HomogeneousMedium(coeffs), False)
     glass = _core.SurfaceMaterial(kind=_core.SurfaceMaterial.Kind.Dielectric, ior=IOR)
     mesh = d.add_mesh(box_mesh((-half, -half, -depth), (half, half, 0.0), glass, medium))
@@ -318,26 +320,12 @@ def marble_coefficients():
 
 def test_marble_slab_matches_the_transport_solution_per_channel():
     sigma_t, albedo = marble_coefficients()
-    d = _core.SceneDesc()
-    coeffs = _core.MediumCoefficients.from_albedo(1.0, tuple(sigma_t), tuple(albedo), (0, 0, 0),
-                                                  _core.isotropic_phase())
-    medium = d.add_medium(_core.HomogeneousMedium(coeffs), False)
-    glass = _core.SurfaceMaterial(kind=_core.SurfaceMaterial.Kind.Dielectric, ior=IOR)
-    mesh = d.add_mesh(box_mesh((-SLAB_H, -SLAB_H, -MARBLE_D), (SLAB_H, SLAB_H, 0.0), glass, medium))
-    d.add_instance(mesh, np.eye(4))
-    d.add_light(_core.dome_light((1, 1, 1)))
-    cam = _core.CameraDesc()
-    cam.projection = _core.CameraDesc.Projection.Orthographic
-    cam.ortho_width = SLAB_VIEW
-    to_world = np.eye(4)
-    to_world[2, 3] = 10.0
-    cam.camera_to_world = to_world
-    d.camera = cam
+    scene = slab_scene(albedo, depth=MARBLE_D, sigma_t=sigma_t)
     s = _core.RenderSettings()  # the defaults: in particular maxDepth and roulette
     s.integrator = integrator_enum("pathTracer")
     s.width = s.height = 64
     s.samples_per_pixel = 16
-    images = pass_images(_core.Scene(d), s, tuple(range(6)))
+    images = pass_images(scene, s, tuple(range(6)))
     r, sigma = mean_sigma(images.mean(axis=(1, 2)) - SPECULAR)
     ref = np.array(MARBLE_REFLECTANCE)
     tol = 4 * sigma + PT_ALLOWANCE * ref
