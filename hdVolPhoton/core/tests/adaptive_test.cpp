@@ -323,9 +323,7 @@ TEST(DenoiserGuides, GlassIsLookedThroughToTheFirstNonSpecularVertex) {
     // one reflected fraction f in red and blue, a few per cent at near-normal incidence (Fresnel:
     // 4% a face, plus internal reflections). Treating the glass itself as the vertex gives f = 1.
     SceneDesc d = wallUnderDome();
-    MeshDesc glass;
-    for (int i = 0; i < 8; ++i) glass.points.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 0.5 : -0.5));
-    glass.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    MeshDesc glass = test::boxMesh("", Vec3(-1, -1, -0.5), Vec3(1, 1, 0.5));
     glass.material.kind = SurfaceMaterial::Kind::Dielectric;
     glass.material.ior = 1.5;
     d.meshes.push_back(glass);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "core/integrator.h"
 #include "tests/testUtil.h"
@@ -25,6 +26,16 @@ inline CameraDesc lookAt(const Vec3& eye, const Vec3& target, double tanHalfFov 
     }
     c.tanHalfFovX = tanHalfFov;
     return c;
+}
+
+/// The closed box [lo, hi] as 12 outward-wound triangles; vertex i is corner (x, y, z) = bits (1, 2, 4)
+/// of i (lo where the bit is clear). The last two triangles are the +x face.
+inline MeshDesc boxMesh(const std::string& name, const Vec3& lo, const Vec3& hi) {
+    MeshDesc m;
+    m.name = name;
+    for (int i = 0; i < 8; ++i) m.points.push_back(Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+    m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    return m;
 }
 
 /// 8x8 pixels, deep paths, a modest photon map: the settings every statistical image test starts from.

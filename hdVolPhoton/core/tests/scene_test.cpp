@@ -381,12 +381,8 @@ TEST(SceneMedia, OpenMeshMediumIsCutAtItsBoundsNotInfinite) {
     // A fog cube with one face missing: paths leave through the hole. Neither integrator may crash
     // or wander an infinite medium; the medium ends at the mesh's bounding box and the dome shows.
     SceneDesc d;
-    MeshDesc cube;
-    cube.name = "openCube";
-    for (int z : {-1, 1})
-        for (int y : {-1, 1})
-            for (int x : {-1, 1}) cube.points.push_back(Vec3(x, y, z));
-    cube.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6};  // no +x face
+    MeshDesc cube = test::boxMesh("openCube", Vec3(-1, -1, -1), Vec3(1, 1, 1));
+    cube.indices.resize(cube.indices.size() - 6);  // no +x face
     cube.material.kind = SurfaceMaterial::Kind::Boundary;
     cube.interiorMedium = 0;
     d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase())));
@@ -433,14 +429,7 @@ TEST(SceneLights, DielectricsWithNoLightInsideAreSealedFromNextEventEstimation) 
     // Shadow rays stop at dielectric surfaces, so from inside a closed dielectric no light outside
     // it can be sampled: the integrators skip next-event estimation there (Scene::sealedFromLights).
     // A light whose extent overlaps the mesh's bounds, an open mesh or a boundary mesh must not seal.
-    auto box = [](const std::string& name, double h) {  // closed: every edge in two triangles
-        MeshDesc m;
-        m.name = name;
-        for (int i = 0; i < 8; ++i) m.points.push_back(Vec3(i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h));
-        m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
-                     2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
-        return m;
-    };
+    auto box = [](const std::string& name, double h) { return test::boxMesh(name, Vec3(-h, -h, -h), Vec3(h, h, h)); };
     auto scene = [&](std::vector<LightPtr> lights, bool emissiveInside) {
         SceneDesc d;
         d.meshes.push_back(box("glass", 1.0));
