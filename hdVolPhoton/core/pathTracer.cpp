@@ -59,7 +59,8 @@ public:
             else out.multiple += L;
         };
 
-        while (true) {
+        for (int segment = 0;; ++segment) {
+            rng.startSegment(segment);
             PathSegment ahead = nextSegment(path, stack, firstSegment);
             const double tEnd = ahead.tEnd;
             if (firstSegment && ahead.hasHit) out.depth = ahead.hit.t;
@@ -77,10 +78,12 @@ public:
                     double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
                     if (hasPointLights_) {
                         support = mediaSupport(media, local, length);
+                        rng.event(Rng::Event::Equiangular);
                         Spectrum L = equiangularPointLight(media, local, support, stack, beta, rng);
                         if (branch == Branch::Undecided) out.single += L;
                         else add(L, false);
                     }
+                    rng.event(Rng::Event::Flight);
                     FlightEnd end = sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
                         if (emissive && !e.mp.emission.isBlack()) {
                             Spectrum L = beta * e.mp.emission / e.sigmaMaj;
@@ -118,6 +121,7 @@ public:
                 const MediumProperties& mp = scatter.mp;
                 Vec3 p = scatter.p;
                 // Next-event estimation (none inside a dielectric that no shadow ray can leave).
+                rng.event(Rng::Event::Light);
                 DirectSample ds = scene_.sealedFromLights(stack) ? DirectSample{} : sampleDirect(p, rng);
                 if (ds.light >= 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack()) {
                     double cosTheta = dot(ray.d, ds.ls.wi);
@@ -136,8 +140,9 @@ public:
                     }
                 }
                 // Phase sampling.
-                double uLobe = rng.uniform();
+                rng.event(Rng::Event::Scatter);
                 auto [s1, s2] = rng.uniform2();
+                double uLobe = rng.uniform();
                 Vec3 w = mp.sampleScatter(ray.d, uLobe, s1, s2);
                 double cosTheta = dot(ray.d, w);
                 double pdf = mp.scatterPdf(cosTheta);
@@ -300,6 +305,7 @@ private:
         if (depth < settings_.rouletteDepth) return true;
         double p = rouletteSurvival(beta.maxValue(), depth);
         if (p >= 1) return true;
+        rng.event(Rng::Event::Roulette);
         if (!(rng.uniform() < p)) return false;
         beta /= p;
         return true;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -114,7 +115,7 @@ public:
     }
     /// Uniform in [0, 1): 53 random bits from two draws, so the value is never rounded up to 1.
     double uniform() {
-        if (qmcDim_ < qmcDims_) return stratified();
+        if (qmcDim_ < qmcEnd_) return stratified();
         uint64_t hi = nextU32() >> 5, lo = nextU32() >> 6;  // 27 + 26 bits
         return static_cast<double>((hi << 26) | lo) * (1.0 / 9007199254740992.0);
     }
@@ -122,14 +123,16 @@ public:
     /// Two draws for one 2D sample. In the stratified prefix both come from one Sobol' pair (a draw
     /// is skipped when the current pair is half used), so the 2D sample is stratified as a whole.
     std::pair<double, double> uniform2() {
-        if (qmcDim_ < qmcDims_ && (qmcDim_ & 1)) ++qmcDim_;
+        if (qmcDim_ < qmcEnd_ && (qmcDim_ & 1)) ++qmcDim_;
+        if (qmcDim_ + 1 >= qmcEnd_) qmcEnd_ = qmcDim_;  // no whole pair left in this event: both from PCG32
         double a = uniform();
         double b = uniform();
         return {a, b};
     }
 
-    /// Makes the next `dims` draws sample `sampleIndex` of a padded, shuffled, Owen-scrambled 2D
-    /// Sobol' sequence (Burley 2020, sec. 4; pbrt-v4's PaddedSobolSampler is the same design): draws
+    /// Makes dimensions [0, dims) of this sample come from sample `sampleIndex` of a padded, shuffled,
+    /// Owen-scrambled 2D Sobol' sequence (Burley 2020, sec. 4; pbrt-v4's PaddedSobolSampler is the same
+    /// design); draws take them in order unless startSegment()/event() place them. Dimensions
     /// 2k and 2k+1 are a (0, 2)-sequence over the sample index, its index shuffled and its values
     /// scrambled by hashes of (key, k). Each sample is still uniform on the unit hypercube (so every
     /// estimate stays unbiased and seeds stay independent), but the samples of one pixel over its
@@ -140,13 +143,69 @@ public:
         qmcIndexReversed_ = reverseBits32(sampleIndex);
         qmcKey_ = key;
         qmcDim_ = 0;
-        qmcDims_ = dims;
+        qmcDims_ = qmcEnd_ = dims;
+        qmcPairCached_ = -1;
+        segmentBase_ = -1;
+    }
+
+    /// Fixed dimensions per path segment (pbrt-v4's samplers give each bounce the same dimensions;
+    /// its volumetric path tracer draws delta tracking from a separate generator for that reason).
+    /// Without this the k-th draw of a path belongs to whatever event happens to make it: a null
+    /// collision earlier in the path shifts every later light and phase sample onto other dimensions,
+    /// and the Sobol' pairs stratify nothing past the first medium. After startSegment(s), event(e)
+    /// makes the next draws (at most the event's width) come from dimensions CameraDims +
+    /// SegmentDims * s + offset(e); further draws of the event (ratio tracking's, delta tracking's
+    /// null collisions) come from PCG32. Dimensions only move forward: an event whose dimensions a
+    /// sample has already passed draws from PCG32, so no dimension is ever used twice in one sample
+    /// (which would correlate two decisions of one path and bias it). Without startSegment() event()
+    /// does nothing and draws take the dimensions in order (the photon map's camera paths).
+    static constexpr int CameraDims = 4;    ///< pixel position pair and lens pair
+    static constexpr int SegmentDims = 24;  ///< per segment: the layout of Event
+    enum class Event : int {
+        Equiangular = 0,  ///< 2: light pick, distance
+        Flight = 2,       ///< 10: the first five tentative collisions, each with its real/null choice
+        Light = 12,       ///< 8: light pick and position pair, or one pair per light (lightPair)
+        Scatter = 20,     ///< 3: direction pair, then lobe or Fresnel choice
+        Roulette = 23,    ///< 1
+    };
+    static constexpr int eventWidth(Event e) {
+        switch (e) {
+            case Event::Equiangular: return 2;
+            case Event::Flight: return 10;
+            case Event::Light: return 8;
+            case Event::Scatter: return 3;
+            case Event::Roulette: return 1;
+        }
+        return 0;
+    }
+    void startSegment(int segment) {
+        if (qmcDims_ <= 0) return;
+        segmentBase_ = CameraDims + SegmentDims * segment;
+        qmcEnd_ = std::min(qmcEnd_, qmcDim_);  // draws outside an event: PCG32
+    }
+    void event(Event e) { beginDims(static_cast<int>(e), eventWidth(e)); }
+    /// The pair of light `i` (< 4) of a vertex that samples every light: dimensions Light + 2i.
+    void lightPair(int i) {
+        if (i < 4) beginDims(static_cast<int>(Event::Light) + 2 * i, 2);
+        else if (segmentBase_ >= 0) qmcEnd_ = qmcDim_;
     }
 
 private:
+    void beginDims(int offset, int count) {
+        if (segmentBase_ < 0) return;
+        int first = segmentBase_ + offset;
+        if (first >= qmcDim_ && first < qmcDims_) {
+            qmcDim_ = first;
+            qmcEnd_ = std::min(first + count, qmcDims_);
+        } else {
+            qmcEnd_ = qmcDim_;  // passed (or beyond the stratified dimensions): PCG32
+        }
+    }
+
     double stratified() {
         int pair = qmcDim_ >> 1;
-        if ((qmcDim_ & 1) == 0) {
+        if (pair != qmcPairCached_) {
+            qmcPairCached_ = pair;
             // Shuffled index i = owenScramble(index) = reverse(r); values owenScramble(sobol0(i)) and
             // owenScramble(sobol1(i)), with the bit reversals that cancel left out.
             uint64_t h = mix64(qmcKey_ + static_cast<uint64_t>(pair + 1) * 0x9e3779b97f4a7c15ULL);
@@ -161,7 +220,8 @@ private:
     uint64_t state_, inc_;
     uint64_t qmcKey_ = 0;
     uint32_t qmcIndexReversed_ = 0, qmcPair_[2] = {0, 0};
-    int qmcDim_ = 0, qmcDims_ = 0;
+    int qmcDim_ = 0, qmcDims_ = 0, qmcEnd_ = 0, qmcPairCached_ = -1;
+    int segmentBase_ = -1;  ///< first dimension of the current segment; -1: draws in order
 };
 
 }  // namespace volphoton

@@ -33,12 +33,15 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
     };
     if (surfaceSamplesAllLights()) {
         Spectrum sum;
-        for (const LightPtr& light : scene_.lights()) {
+        for (size_t i = 0; i < scene_.lights().size(); ++i) {
+            const LightPtr& light = scene_.lights()[i];
+            rng.lightPair(static_cast<int>(i));
             auto [u1, u2] = rng.uniform2();
             sum += estimate(light->sample(hit.p, u1, u2), 1.0);
         }
         return sum;
     }
+    rng.event(Rng::Event::Light);
     DirectSample ds = sampleDirect(hit.p, rng);
     return ds.light >= 0 ? estimate(ds.ls, ds.pickProb) : Spectrum();
 }
@@ -122,6 +125,7 @@ SurfaceStep Integrator::cameraSurfaceHit(PathRay& path, const SurfaceHit& hit, M
     if (++depth > settings_.maxDepth) return SurfaceStep::Stop;
     if (m.kind == SurfaceMaterial::Kind::Lambertian && !m.albedo.isBlack())
         add(beta * directAtLambertian(ray, hit, stack, rng, mis));
+    rng.event(Rng::Event::Scatter);
     *scatter = scatterSurface(ray, hit, stack, rng, true);
     if (scatter->type == SurfaceScatter::Type::Absorbed) return SurfaceStep::Stop;
     beta *= scatter->weight;

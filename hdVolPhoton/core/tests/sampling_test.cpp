@@ -116,3 +116,106 @@ TEST(Sampling, StratifiedEstimatesConvergeFaster) {
     }
     EXPECT_LT(std::sqrt(mseQmc) * 10, std::sqrt(mseRandom));
 }
+
+namespace {
+
+/// Sample `i` of pixel `key` as the path tracer draws it: camera pair, then per segment an
+/// equiangular pair, a flight event with `flights(i, s)` tentative collisions (a varying number of
+/// draws, as delta tracking makes), then the light pick and pair. Returns segment `segment`'s light pair.
+std::pair<uint32_t, uint32_t> lightPairAfterFlights(uint64_t key, uint32_t i, int segment, int dims) {
+    Rng rng(key, i);
+    rng.stratify(i, key, dims);
+    rng.uniform2();
+    rng.uniform2();
+    Rng count(key ^ 0x5a5a, i);  // how many draws each flight takes: 0..15, unrelated to the samples
+    std::pair<double, double> u;
+    for (int s = 0; s <= segment; ++s) {
+        rng.startSegment(s);
+        rng.event(Rng::Event::Flight);
+        for (int k = static_cast<int>(count.nextU32() % 16); k > 0; --k) rng.uniform();
+        rng.event(Rng::Event::Light);
+        rng.uniform();  // light pick
+        u = rng.uniform2();
+        rng.event(Rng::Event::Scatter);
+        rng.uniform2();
+        rng.uniform();
+    }
+    return {static_cast<uint32_t>(std::ldexp(u.first, 32)), static_cast<uint32_t>(std::ldexp(u.second, 32))};
+}
+
+}  // namespace
+
+TEST(Sampling, SegmentEventsKeepTheirDimensionsWhateverCameBefore) {
+    // The light pair of segment s stays a (0, m, 2)-net over a pixel's samples however many draws
+    // the flights before it took (0..15 each, so without per-segment dimensions it would land on
+    // different dimensions in different samples and stratify nothing).
+    for (uint64_t key : {3ull, 0xfeedull})
+        for (int segment : {0, 1, 4})
+            for (int m : {4, 7}) {
+                std::vector<std::pair<uint32_t, uint32_t>> pts;
+                for (uint32_t i = 0; i < (1u << m); ++i) pts.push_back(lightPairAfterFlights(key, i, segment, 1024));
+                EXPECT_TRUE(isNet(pts, m)) << key << " segment " << segment << " m " << m;
+            }
+    // Past the stratified dimensions the draws are independent (PCG32): no net at segment 4 with 64 dims.
+    std::vector<std::pair<uint32_t, uint32_t>> pts;
+    for (uint32_t i = 0; i < 128; ++i) pts.push_back(lightPairAfterFlights(3, i, 4, 64));
+    EXPECT_FALSE(isNet(pts, 7));
+}
+
+TEST(Sampling, NoDimensionIsUsedTwiceInOneSample) {
+    // Going back to an event whose dimensions the sample has passed draws from PCG32, not the
+    // stratified value already used (which would correlate two decisions of one path).
+    for (uint32_t i = 0; i < 64; ++i) {
+        Rng a(7, i), b(7, i);
+        a.stratify(i, 77, 256);
+        b.stratify(i, 77, 256);
+        a.startSegment(0);
+        b.startSegment(0);
+        a.event(Rng::Event::Flight);
+        double flight = a.uniform();
+        b.event(Rng::Event::Scatter);
+        b.uniform();
+        b.event(Rng::Event::Flight);  // behind: PCG32
+        EXPECT_NE(b.uniform(), flight) << i;
+        // A pair that does not fit in what is left of an event comes from PCG32 as a whole.
+        Rng c(7, i);
+        c.stratify(i, 77, 256);
+        c.startSegment(0);
+        c.event(Rng::Event::Roulette);  // width 1
+        auto [x, y] = c.uniform2();
+        Rng d(7, i);
+        d.stratify(i, 77, 256);
+        for (int k = 0; k < Rng::CameraDims + static_cast<int>(Rng::Event::Roulette) - 1; ++k) d.uniform();
+        auto [sx, sy] = d.uniform2();  // the stratified pair holding the roulette's dimension
+        EXPECT_NE(y, sy) << i;
+        EXPECT_NE(x, sx) << i;
+    }
+}
+
+TEST(Sampling, NeighbouringPixelsAreUncorrelated) {
+    // Pixels are keyed as the renderer keys them (hashKeys of a tag, x, y, seed). For sample index i
+    // of pixel (x, y) and of its right and lower neighbours, the same dimension's values must be
+    // uncorrelated (each pixel's points are scrambled and shuffled independently): over 160 x 120
+    // pixels x 2 indices (38400 pairs) the correlation's standard error is 1/sqrt(38400) = 0.005;
+    // the tolerance is 5 of them. The test fails if the scramble seeds ignore the pixel (correlation 1).
+    for (int dim : {0, 1, Rng::CameraDims + static_cast<int>(Rng::Event::Light) + 1})
+        for (int dx : {0, 1}) {
+            int dy = 1 - dx;
+            double sum = 0;
+            int n = 0;
+            for (uint32_t index : {0u, 13u})
+                for (int y = 0; y < 120; ++y)
+                    for (int x = 0; x < 160; ++x) {
+                        auto draw = [&](int px, int py) {
+                            Rng rng(hashKeys(px, py, 0), index);
+                            rng.stratify(index, hashKeys(0x51534d43ULL, px, py, 0), 64);
+                            double u = 0;
+                            for (int k = 0; k <= dim; ++k) u = rng.uniform();
+                            return u;
+                        };
+                        sum += (draw(x, y) - 0.5) * (draw(x + dx, y + dy) - 0.5) * 12;
+                        ++n;
+                    }
+            EXPECT_NEAR(sum / n, 0.0, 5 / std::sqrt(double(n))) << "dim " << dim << " dx " << dx;
+        }
+}
