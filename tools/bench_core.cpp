@@ -7,6 +7,7 @@
 // collision or the end of the ray) and per transmittance query, for each medium; then the cost of
 // rays through a sparse grid as its bounding box grows with the data held fixed (empty space must be
 // ~free), and the measured bias of the deterministic transmittance cut-off.
+#include <embree3/rtcore.h>
 #include <openvdb/openvdb.h>
 
 #include <chrono>
@@ -18,10 +19,13 @@
 #include "core/freeFlight.h"
 #include "core/gridMedium.h"
 #include "core/homogeneousMedium.h"
+#include "core/integrator.h"
+#include "core/lights.h"
 #include "core/mediumAggregate.h"
 #include "core/proceduralCloud.h"
 #include "core/sampling.h"
 #include "core/transmittance.h"
+#include "core/workCount.h"
 
 using namespace volphoton;
 
@@ -80,6 +84,100 @@ std::shared_ptr<GridMedium> twoBlobs(int separation) {
     g.density = grid;
     return std::make_shared<GridMedium>(d, g);
 }
+/// Benchmark scene 1 (tools/bench/scenes.py, homogeneous_cube) built directly: a boundary box
+/// [-1, 1]^3 of sigma_t 2, albedo 0.8, HG g 0.5 under a unit dome, camera at (3, 2.2, 4.4) looking
+/// at (0, -0.1, 0) with a 40 degree horizontal field of view.
+SceneDesc homogeneousCubeScene() {
+    SceneDesc d;
+    MeshDesc box;
+    box.name = "cube";
+    for (int i = 0; i < 8; ++i) box.points.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
+    box.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    box.material.kind = SurfaceMaterial::Kind::Boundary;
+    box.interiorMedium = 0;
+    d.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeHenyeyGreensteinPhase(0.5))));
+    d.meshes.push_back(box);
+    d.instances.push_back({0, Affine()});
+    d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    Vec3 eye(3, 2.2, 4.4), f = normalize(Vec3(0, -0.1, 0) - eye);
+    Vec3 x = normalize(cross(f, Vec3(0, 1, 0))), y = cross(x, f);
+    for (int r = 0; r < 3; ++r) {
+        d.camera.cameraToWorld.m[r][0] = x[r];
+        d.camera.cameraToWorld.m[r][1] = y[r];
+        d.camera.cameraToWorld.m[r][2] = -f[r];
+        d.camera.cameraToWorld.m[r][3] = eye[r];
+    }
+    d.camera.tanHalfFovX = std::tan(20 * Pi / 180);
+    return d;
+}
+
+/// The path tracer's cost per sample and per ray on scene 1 against the cost of the rays alone:
+/// Scene::intersect (Embree's rtcIntersect1 and our hit set-up) on rays from points inside the cube in
+/// random directions, the rays a path tracer's vertices cast there. Single thread.
+void pathTracerThroughput(bool quick) {
+    auto scene = std::make_shared<Scene>(homogeneousCubeScene());
+    RenderSettings s;
+    s.width = 160;
+    s.height = 120;
+    s.samplesPerPixel = quick ? 16 : 64;
+    s.noiseTarget = 0;
+    s.threads = 1;  // TBB's parallelism capped at 1: the pass runs on this thread, whose counters we read
+    Renderer warm(scene, s);
+    warm.render();
+    Renderer r(scene, s);
+    work::Snapshot before = work::snapshot();
+    double ns = nsPer(1, [&](int) { r.render(); });
+    work::Count w = work::since(before);
+    double samples = double(s.width) * s.height * s.samplesPerPixel;
+
+    Rng rng(5);
+    std::vector<Ray> rays;
+    for (int i = 0; i < 4096; ++i)
+        rays.push_back({Vec3(2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1) * 0.999,
+                        uniformSphere(rng.uniform(), rng.uniform())});
+    SurfaceHit hit;
+    double nsRay = nsPer(quick ? 200000 : 2000000, [&](int i) { sink = scene->intersect(rays[i & 4095], 0.0, Infinity, &hit); });
+
+    // Raw Embree: the same 12 triangles in one flat scene (no instance level), rtcIntersect1 alone.
+    RTCDevice device = rtcNewDevice("verbose=0");
+    RTCScene flat = rtcNewScene(device);
+    rtcSetSceneFlags(flat, RTC_SCENE_FLAG_ROBUST);
+    const MeshDesc& box = scene->desc().meshes[0];
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), box.points.size()));
+    for (size_t i = 0; i < box.points.size(); ++i)
+        for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(box.points[i][k]);
+    unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), box.indices.size() / 3));
+    std::copy(box.indices.begin(), box.indices.end(), idx);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(flat, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(flat);
+    double nsRaw = nsPer(quick ? 200000 : 2000000, [&](int i) {
+        const Ray& ray = rays[i & 4095];
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        RTCRayHit rh{};
+        rh.ray.org_x = float(ray.o.x), rh.ray.org_y = float(ray.o.y), rh.ray.org_z = float(ray.o.z);
+        rh.ray.dir_x = float(ray.d.x), rh.ray.dir_y = float(ray.d.y), rh.ray.dir_z = float(ray.d.z);
+        rh.ray.tfar = std::numeric_limits<float>::infinity();
+        rh.ray.mask = ~0u;
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(flat, &ctx, &rh);
+        sink = rh.ray.tfar;
+    });
+    rtcReleaseScene(flat);
+    rtcReleaseDevice(device);
+
+    double nsSample = ns / samples, raysPerSample = w.rays / samples;
+    std::printf("\n## Path tracer throughput, scene 1 (homogeneous cube), 160x120 x %d spp, one thread\n\n", s.samplesPerPixel);
+    std::printf("| ns per sample | rays per sample | medium lookups per sample | ns per ray, rays alone (Scene::intersect) "
+                "| ns per ray, raw Embree (one flat scene) | rays' share of the sample | ns per ray, whole path |\n|---|---|---|---|---|---|---|\n");
+    std::printf("| %.0f | %.2f | %.2f | %.0f | %.0f | %.0f%% | %.0f |\n", nsSample, raysPerSample, w.lookups / samples, nsRay, nsRaw,
+                100 * raysPerSample * nsRay / nsSample, nsSample / raysPerSample);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -175,5 +273,6 @@ int main(int argc, char** argv) {
         double mean = sum / m, se = std::sqrt(std::max(0.0, sum2 / m - mean * mean) / m);
         std::printf("| %6.2f | %.5f | %+.5f +- %.5f | %.0f |\n", cutoff, mean, mean - exact, se, ns);
     }
+    pathTracerThroughput(quick);
     return 0;
 }
