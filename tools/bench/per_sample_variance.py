@@ -1,0 +1,59 @@
+"""Per-sample variance of our path tracer on benchmark scenes: for each pixel, the variance across
+seeds of its mean over `spp` samples, times spp, averaged over the pixels (so independent samples
+give the same figure at any spp, and stratified samples a lower one). Also the mean and the time
+per pass. The scene's own RenderSettings are used except integrator (path tracer), adaptive sampling
+and time limit (off), spp, seed and --dims (stratifiedDims).
+
+    python tools/bench/per_sample_variance.py homogeneous_cube,surfaces_only --spp 64 --seeds 16
+
+Compare two builds side by side by running it once with each on PYTHONPATH (a copy of another
+build's installed `volphoton` package first on PYTHONPATH)."""
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from bench_load import load_bench_scene  # noqa: E402
+from volphoton import _core  # noqa: E402
+
+
+def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
+    """(per-sample variance, image mean, seconds per pass) of scene `name`."""
+    rs, tr = load_bench_scene(name, width, height)
+    scene = _core.Scene(tr.desc)
+    images = []
+    t0 = time.perf_counter()
+    for seed in range(seeds):
+        s = rs.settings
+        s.width, s.height, s.samples_per_pixel, s.seed = width, height, spp, seed
+        s.noise_target, s.time_limit = 0, 0
+        s.integrator = _core.RenderSettings.Integrator.PathTracer
+        if dims is not None:
+            s.stratified_dims = dims
+        r = _core.Renderer(scene, s)
+        r.render()
+        images.append(np.asarray(r.film.beauty, np.float64))
+    seconds = (time.perf_counter() - t0) / (seeds * spp)
+    images = np.array(images)
+    return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("scenes", help="comma-separated benchmark scene names (testenv/bench/<name>.usda)")
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--seeds", type=int, default=16)
+    ap.add_argument("--dims", type=int, default=None, help="stratifiedDims (default: the build's default)")
+    a = ap.parse_args()
+    print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) |\n|---|---|---|---|")
+    for name in a.scenes.split(","):
+        v, m, sec = per_sample_variance(name, a.spp, a.seeds, a.dims)
+        print("| %s | %.5f | %.5f | %.2f |" % (name, v, m, sec * 1e3), flush=True)
+
+
+if __name__ == "__main__":
+    main()
