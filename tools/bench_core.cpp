@@ -26,6 +26,7 @@
 #include "core/sampling.h"
 #include "core/transmittance.h"
 #include "core/workCount.h"
+#include "tests/renderTestUtil.h"
 
 using namespace volphoton;
 
@@ -89,10 +90,7 @@ std::shared_ptr<GridMedium> twoBlobs(int separation) {
 /// at (0, -0.1, 0) with a 40 degree horizontal field of view.
 SceneDesc homogeneousCubeScene() {
     SceneDesc d;
-    MeshDesc box;
-    box.name = "cube";
-    for (int i = 0; i < 8; ++i) box.points.push_back(Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
-    box.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    MeshDesc box = test::boxMesh("cube", Vec3(-1, -1, -1), Vec3(1, 1, 1));
     box.material.kind = SurfaceMaterial::Kind::Boundary;
     box.interiorMedium = 0;
     d.media.push_back(std::make_shared<HomogeneousMedium>(
@@ -100,15 +98,7 @@ SceneDesc homogeneousCubeScene() {
     d.meshes.push_back(box);
     d.instances.push_back({0, Affine()});
     d.lights.push_back(makeDomeLight(Spectrum(1.0)));
-    Vec3 eye(3, 2.2, 4.4), f = normalize(Vec3(0, -0.1, 0) - eye);
-    Vec3 x = normalize(cross(f, Vec3(0, 1, 0))), y = cross(x, f);
-    for (int r = 0; r < 3; ++r) {
-        d.camera.cameraToWorld.m[r][0] = x[r];
-        d.camera.cameraToWorld.m[r][1] = y[r];
-        d.camera.cameraToWorld.m[r][2] = -f[r];
-        d.camera.cameraToWorld.m[r][3] = eye[r];
-    }
-    d.camera.tanHalfFovX = std::tan(20 * Pi / 180);
+    d.camera = test::lookAt(Vec3(3, 2.2, 4.4), Vec3(0, -0.1, 0), std::tan(20 * Pi / 180));
     return d;
 }
 
