@@ -135,6 +135,7 @@ protected:
     /// by power when the scene has at most this many: picking one of a sun and a sky had 5x the
     /// per-sample variance of the two lights' separate renders on benchmark scene 7 (issue 16).
     static constexpr size_t AllLightsMax = 4;
+    static_assert(2 * AllLightsMax <= Rng::eventWidth(Rng::Event::Light), "each light of an all-lights vertex has its own sampler pair");
     bool surfaceSamplesAllLights() const { return scene_.lights().size() <= AllLightsMax; }
     /// Probability with which a lambertian vertex's next-event estimation chooses light i (for MIS).
     double surfaceLightPickProb(int light) const { return surfaceSamplesAllLights() ? 1.0 : lightPickProb(light); }

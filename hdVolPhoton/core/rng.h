@@ -2,8 +2,8 @@
 // (pixel, sample index, pass, user seed), never from a clock, so a render is bit-identical across runs.
 #pragma once
 
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <utility>
 
@@ -184,9 +184,10 @@ public:
         qmcEnd_ = std::min(qmcEnd_, qmcDim_);  // draws outside an event: PCG32
     }
     void event(Event e) { beginDims(static_cast<int>(e), eventWidth(e)); }
-    /// The pair of light `i` (< 4) of a vertex that samples every light: dimensions Light + 2i.
+    /// The pair of light `i` of a vertex that samples every light: dimensions Light + 2i while they
+    /// fit in the light event's width (four lights, Integrator's AllLightsMax), else PCG32.
     void lightPair(int i) {
-        if (i < 4) beginDims(static_cast<int>(Event::Light) + 2 * i, 2);
+        if (2 * i + 2 <= eventWidth(Event::Light)) beginDims(static_cast<int>(Event::Light) + 2 * i, 2);
         else if (segmentBase_ >= 0) qmcEnd_ = qmcDim_;
     }
 
