@@ -3,6 +3,9 @@
 #include "core/embreeRay.h"
 #include "core/workCount.h"
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -96,31 +99,58 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         if (m.interiorMedium >= static_cast<int>(desc_.media.size()))
             throw std::invalid_argument("mesh '" + m.name + "': interior medium index out of range");
         meshClosed_.push_back(isClosedMesh(m.indices));
-        RTCScene s = rtcNewScene(device_);
-        // Watertight ray/triangle tests: without ROBUST, a ray through a shared edge can miss both
-        // triangles, and a path inside a closed medium mesh walks out through the "hole".
-        rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    }
+    // A mesh with one instance goes into the top-level scene as world-space triangles (no instance
+    // level: Embree's two-level traversal cost 84 ns a ray against 66 flat on benchmark scene 1,
+    // tools/bench_core); meshes instanced more than once keep one shared scene. Precision is the
+    // same either way: Embree transforms the float ray into an instance's space in float, and hits
+    // are rebuilt in double from the object-space triangle and the barycentrics (intersect()).
+    std::vector<int> instanceCount(desc_.meshes.size(), 0);
+    std::vector<std::optional<Affine>> inverses;
+    for (const InstanceDesc& inst : desc_.instances) {
+        if (inst.mesh < 0 || inst.mesh >= static_cast<int>(desc_.meshes.size()))
+            throw std::invalid_argument("instance " + std::to_string(inverses.size()) + ": mesh index out of range");
+        inverses.push_back(inst.transform.inverse());
+        if (inverses.back()) ++instanceCount[inst.mesh];
+    }
+    auto worldFloatPoints = [](const MeshDesc& m, const Affine* toWorld, std::vector<float>* out) {
+        out->resize(3 * m.points.size());
+        for (size_t i = 0; i < m.points.size(); ++i) {
+            Vec3 p = toWorld ? toWorld->point(m.points[i]) : m.points[i];
+            for (int k = 0; k < 3; ++k) (*out)[3 * i + k] = static_cast<float>(p[k]);
+        }
+        return std::all_of(out->begin(), out->end(), [](float f) { return std::isfinite(f); });
+    };
+    auto triangles = [&](const MeshDesc& m, const std::vector<float>& points) {
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
         float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.points.size()));
-        for (size_t i = 0; i < m.points.size(); ++i) {
-            v[3 * i] = static_cast<float>(m.points[i].x);
-            v[3 * i + 1] = static_cast<float>(m.points[i].y);
-            v[3 * i + 2] = static_cast<float>(m.points[i].z);
-        }
+        std::copy(points.begin(), points.end(), v);
         unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.indices.size() / 3));
         std::copy(m.indices.begin(), m.indices.end(), idx);
         rtcCommitGeometry(g);
-        rtcAttachGeometry(s, g);
-        rtcReleaseGeometry(g);
-        rtcCommitScene(s);
-        meshScenes_.push_back(s);
-    }
+        return g;
+    };
+    std::vector<float> points;
+    meshScenes_.assign(desc_.meshes.size(), nullptr);
+    auto meshScene = [&](int mi) {
+        if (!meshScenes_[mi]) {
+            RTCScene s = rtcNewScene(device_);
+            // Watertight ray/triangle tests: without ROBUST, a ray through a shared edge can miss both
+            // triangles, and a path inside a closed medium mesh walks out through the "hole".
+            rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+            worldFloatPoints(desc_.meshes[mi], nullptr, &points);
+            RTCGeometry g = triangles(desc_.meshes[mi], points);
+            rtcAttachGeometry(s, g);
+            rtcReleaseGeometry(g);
+            rtcCommitScene(s);
+            meshScenes_[mi] = s;
+        }
+        return meshScenes_[mi];
+    };
     meshBounds_.resize(desc_.meshes.size());
     for (size_t ii = 0; ii < desc_.instances.size(); ++ii) {
         const InstanceDesc& inst = desc_.instances[ii];
-        if (inst.mesh < 0 || inst.mesh >= static_cast<int>(meshScenes_.size()))
-            throw std::invalid_argument("instance " + std::to_string(ii) + ": mesh index out of range");
-        auto inv = inst.transform.inverse();
+        const std::optional<Affine>& inv = inverses[ii];
         if (!inv) {
             warn("instance " + std::to_string(ii) + " of mesh '" + desc_.meshes[inst.mesh].name +
                  "': transform is not invertible or not finite; the instance is skipped");
@@ -128,13 +158,18 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             continue;
         }
         instanceInverse_.push_back(*inv);
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-        rtcSetGeometryInstancedScene(g, meshScenes_[inst.mesh]);
-        float xfm[12];  // column-major 3x4
-        for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = static_cast<float>(inst.transform.m[r][c]);
-        rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-        rtcCommitGeometry(g);
+        RTCGeometry g;
+        if (instanceCount[inst.mesh] == 1 && worldFloatPoints(desc_.meshes[inst.mesh], &inst.transform, &points)) {
+            g = triangles(desc_.meshes[inst.mesh], points);
+        } else {
+            g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(g, meshScene(inst.mesh));
+            float xfm[12];  // column-major 3x4
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = static_cast<float>(inst.transform.m[r][c]);
+            rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+            rtcCommitGeometry(g);
+        }
         rtcAttachGeometryByID(top_, g, static_cast<unsigned>(ii));
         rtcReleaseGeometry(g);
         for (const Vec3& p : desc_.meshes[inst.mesh].points) {
@@ -215,7 +250,8 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
 }
 
 Scene::~Scene() {
-    for (RTCScene s : meshScenes_) rtcReleaseScene(s);
+    for (RTCScene s : meshScenes_)
+        if (s) rtcReleaseScene(s);
     if (top_) rtcReleaseScene(top_);
     if (device_) rtcReleaseDevice(device_);
 }
@@ -234,7 +270,8 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
     RTCRayHit rh = embreeRayHit(ray.o, ray.d, tMin, tMax);
     rtcIntersect1(top_, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    int inst = static_cast<int>(rh.hit.instID[0]);
+    // An instance's hit names it in instID; a single-instance mesh's triangles are geometry `instance`.
+    int inst = static_cast<int>(rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID ? rh.hit.instID[0] : rh.hit.geomID);
     const InstanceDesc& id = desc_.instances[inst];
     const MeshDesc& m = desc_.meshes[id.mesh];
     hit->t = rh.ray.tfar;
