@@ -325,6 +325,44 @@ TEST(SceneInstancing, InstancesShareAMeshAndBadTransformsAreSkipped) {
     EXPECT_FALSE(scene.intersect({Vec3(0, 0, 5), Vec3(0, 0, -1)}, 0, Infinity, &hit));  // the singular one is skipped
 }
 
+TEST(SceneInstancing, SingleInstanceMeshesAreFlattenedWithTheSameHits) {
+    // A mesh with one instance goes into the top-level scene as world-space triangles, a shared mesh
+    // stays instanced; either way a hit names its instance and mesh, and its point lies on the
+    // world-space plane (rebuilt in double). Mesh 2's first instance is singular (skipped): its one
+    // valid instance is flattened.
+    MeshDesc quad;
+    quad.points = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0)};
+    quad.indices = {0, 1, 2, 0, 2, 3};
+    SceneDesc d;
+    for (const char* name : {"shared", "single", "afterSingular"}) {
+        d.meshes.push_back(quad);
+        d.meshes.back().name = name;
+    }
+    d.instances.push_back({0, Affine::translate(Vec3(-3, 0, 0))});
+    d.instances.push_back({0, Affine::translate(Vec3(3, 0, 0))});
+    d.instances.push_back({1, Affine::translate(Vec3(0, 0, -2.125)) * Affine::scale(Vec3(2, 2, -2))});  // mirrored
+    d.instances.push_back({2, Affine::scale(Vec3(1, 0, 1))});
+    d.instances.push_back({2, Affine::translate(Vec3(0, 10, -1))});
+    Scene scene(d);
+    struct Case {
+        Vec3 origin;
+        int instance, mesh;
+        double z;
+    };
+    for (const Case& c : {Case{Vec3(-3, 0.3, 5), 0, 0, 0.0}, Case{Vec3(3.2, 0, 5), 1, 0, 0.0}, Case{Vec3(1.5, -1.5, 5), 2, 1, -2.125},
+                          Case{Vec3(0.5, 10.5, 5), 4, 2, -1.0}}) {
+        SurfaceHit hit;
+        ASSERT_TRUE(scene.intersect({c.origin, Vec3(0, 0, -1)}, 0, Infinity, &hit)) << c.instance;
+        EXPECT_EQ(hit.instance, c.instance);
+        EXPECT_EQ(hit.mesh, c.mesh);
+        EXPECT_NEAR(hit.t, 5 - c.z, 1e-5);
+        EXPECT_EQ(hit.p.z, c.z) << c.instance;  // exact: the barycentric point of the double-precision plane
+        EXPECT_NEAR(std::abs(hit.ng.z), 1.0, 1e-12);
+    }
+    SurfaceHit hit;
+    EXPECT_FALSE(scene.intersect({Vec3(0, 0, 5), Vec3(0, 1, 0)}, 0, Infinity, &hit));
+}
+
 TEST(SceneMedia, NestedMediaAndCameraInsideAClosedMesh) {
     SceneDesc d;
     d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(0.5, Spectrum(1.0), Spectrum(0.5), Spectrum(0.0), makeIsotropicPhase())));
