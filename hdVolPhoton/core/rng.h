@@ -160,17 +160,19 @@ public:
     /// (which would correlate two decisions of one path and bias it). Without startSegment() event()
     /// does nothing and draws take the dimensions in order (the photon map's camera paths).
     static constexpr int CameraDims = 4;    ///< pixel position pair and lens pair
-    static constexpr int SegmentDims = 24;  ///< per segment: the layout of Event
+    static constexpr int SegmentDims = 32;  ///< per segment: the layout of Event
     enum class Event : int {
         Equiangular = 0,  ///< 2: light pick, distance
-        Flight = 2,       ///< 10: the first five tentative collisions, each with its real/null choice
-        Light = 12,       ///< 8: light pick and position pair, or one pair per light (lightPair)
-        Scatter = 20,     ///< 3: direction pair, then lobe or Fresnel choice
-        Roulette = 23,    ///< 1
+        Emission = 2,     ///< 8: the emission estimate's first tentative collisions and roulette
+        Flight = 10,      ///< 10: the first five tentative collisions, each with its real/null choice
+        Light = 20,       ///< 8: light pick and position pair, or one pair per light (lightPair)
+        Scatter = 28,     ///< 3: direction pair, then lobe or Fresnel choice
+        Roulette = 31,    ///< 1
     };
     static constexpr int eventWidth(Event e) {
         switch (e) {
             case Event::Equiangular: return 2;
+            case Event::Emission: return 8;
             case Event::Flight: return 10;
             case Event::Light: return 8;
             case Event::Scatter: return 3;

@@ -88,7 +88,7 @@ std::vector<SettingInfo> makeTable() {
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points",
                             &RS::photonBeams));
     t.push_back(intSetting("stratifiedDims", 0, 4096, "", "volphoton:stratifiedDims", "Stratified dimensions (0: independent)",
-                           "", "dimensions per camera sample taken from scrambled Sobol' points; the path tracer gives each path segment the same 24 (388: 16 segments; 0: independent)",
+                           "", "dimensions per camera sample taken from scrambled Sobol' points; the path tracer gives each path segment the same 32 (516: 16 segments; 0: independent)",
                            &RS::stratifiedDims));
     t.push_back(doubleSetting("marchStep", 0, Big, "", "March step (0: auto)", "scene units",
                               "photonMap: single-scattering step (0: 1/256 of the media's diameter)", &RS::marchStep));
