@@ -161,6 +161,8 @@ public:
     /// does nothing and draws take the dimensions in order (the photon map's camera paths).
     static constexpr int CameraDims = 4;    ///< pixel position pair and lens pair
     static constexpr int SegmentDims = 32;  ///< per segment: the layout of Event
+    /// Each event's first dimension in its segment, in the order a segment uses them; its width runs
+    /// to the next one's first (eventWidth).
     enum class Event : int {
         Equiangular = 0,  ///< 2: light pick, distance
         Emission = 2,     ///< 8: the emission estimate's first tentative collisions and roulette
@@ -171,12 +173,12 @@ public:
     };
     static constexpr int eventWidth(Event e) {
         switch (e) {
-            case Event::Equiangular: return 2;
-            case Event::Emission: return 8;
-            case Event::Flight: return 10;
-            case Event::Light: return 8;
-            case Event::Scatter: return 3;
-            case Event::Roulette: return 1;
+            case Event::Equiangular: return int(Event::Emission) - int(e);
+            case Event::Emission: return int(Event::Flight) - int(e);
+            case Event::Flight: return int(Event::Light) - int(e);
+            case Event::Light: return int(Event::Scatter) - int(e);
+            case Event::Scatter: return int(Event::Roulette) - int(e);
+            case Event::Roulette: return SegmentDims - int(e);
         }
         return 0;
     }

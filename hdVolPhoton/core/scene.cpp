@@ -113,7 +113,8 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         inverses.push_back(inst.transform.inverse());
         if (inverses.back()) ++instanceCount[inst.mesh];
     }
-    auto worldFloatPoints = [](const MeshDesc& m, const Affine* toWorld, std::vector<float>* out) {
+    // The mesh's points as floats, in world space when toWorld is given; false if one is not finite.
+    auto floatPoints = [](const MeshDesc& m, const Affine* toWorld, std::vector<float>* out) {
         out->resize(3 * m.points.size());
         for (size_t i = 0; i < m.points.size(); ++i) {
             Vec3 p = toWorld ? toWorld->point(m.points[i]) : m.points[i];
@@ -138,7 +139,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             // Watertight ray/triangle tests: without ROBUST, a ray through a shared edge can miss both
             // triangles, and a path inside a closed medium mesh walks out through the "hole".
             rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
-            worldFloatPoints(desc_.meshes[mi], nullptr, &points);
+            floatPoints(desc_.meshes[mi], nullptr, &points);
             RTCGeometry g = triangles(desc_.meshes[mi], points);
             rtcAttachGeometry(s, g);
             rtcReleaseGeometry(g);
@@ -159,7 +160,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         }
         instanceInverse_.push_back(*inv);
         RTCGeometry g;
-        if (instanceCount[inst.mesh] == 1 && worldFloatPoints(desc_.meshes[inst.mesh], &inst.transform, &points)) {
+        if (instanceCount[inst.mesh] == 1 && floatPoints(desc_.meshes[inst.mesh], &inst.transform, &points)) {
             g = triangles(desc_.meshes[inst.mesh], points);
         } else {
             g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
