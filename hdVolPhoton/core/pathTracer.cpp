@@ -12,7 +12,7 @@
 // segment is estimated by ratio tracking over the whole segment (ratioTrackedEmission), apart from
 // where the path's flight scatters: 4.1x lower per-sample variance than collecting beta * emission /
 // sigma_maj at the flight's own tentative collisions (pbrt-v4's estimator) on benchmark scene 6, 6.2x
-// with its own sampler dimensions, at 1.7x the time per sample.
+// with its own sampler dimensions, at 1.5x the time per sample (tools/bench/README.md).
 // Direct light: next-event estimation with shadow transmittance (closed form where the media have one,
 // else ratio tracking), combined with phase/BSDF sampling by MIS (power heuristic) for lights with
 // extent, emissive meshes included (Scene::instanceLight: their hits are weighted by emitterDensity). Point, spot and sphere lights add a second strategy on every segment in a medium:
