@@ -38,6 +38,16 @@ inline float kernelRadius(float stored, double passRadius) {
     return std::isnan(stored) ? rMax : std::clamp(stored, rMin, rMax);
 }
 
+/// The fraction of a disc of radius r on the near side of a line at distance `ell` from its centre
+/// (1 for ell >= r, 1/2 at ell = 0): one minus the circular segment beyond the chord,
+/// (r^2 acos(ell/r) - ell sqrt(r^2 - ell^2)) / (pi r^2). Negative distances count as 0 (the centre on
+/// the line), so the fraction is never below 1/2.
+inline double discFractionInside(double ell, double r) {
+    if (!(ell < r)) return 1.0;
+    double u = std::max(0.0, ell / r);
+    return 1.0 - (std::acos(u) - u * std::sqrt(std::max(0.0, 1.0 - u * u))) / Pi;
+}
+
 /// \class PhotonMap
 /// Built once per pass from that pass's photons, then queried concurrently.
 class PhotonMap {

@@ -333,8 +333,8 @@ private:
         // onto the ray just outside it, and dropping them loses energy wherever the source term is
         // concentrated at the interface (a dense slab's skin); kept, the kernel only blurs it.
         if (map_) {
-            double beam = map_->radius();
-            r.multiple = gather(ray, std::max(0.0, supportStart - beam), std::min(length, supportEnd + beam), tr, stack);
+            double beam = map_->radius(), a = std::max(0.0, supportStart - beam), b = std::min(length, supportEnd + beam);
+            r.multiple = gather(ray, a, b, tr, stack, SurfaceCuts(scene_, ray, a, b, beam));
         } else if (beams_) {
             r.multiple = gatherBeams(media, ray, supportStart, std::min(length, supportEnd), tr, stack);
         }
@@ -409,12 +409,68 @@ private:
         return static_cast<float>(settings_.photonRadiusMfp / sigmaTMax);
     }
 
-    Spectrum gather(const Ray& ray, double a, double b, const SegmentTransmittance& tr, const MediumStack& stack) const {
+    /// Surfaces that cut the gather discs along a camera segment (the kernel's boundary bias). Photons
+    /// lie on the segment's side of a surface only, so the disc of radius r around a ray point within r
+    /// of one collects photons over the part of its area on that side: the count estimates f x the
+    /// density, f the disc's fraction inside (1/2 at the surface). Each photon's contribution is divided
+    /// by f at its ray point (the renormalisation correction of kernel density estimation at a boundary;
+    /// M. C. Jones 1993, "Simple boundary correction for kernel density estimation"). Without it a camera
+    /// ray grazing the ground of benchmark scene 5 lost 29% of its blue multiple scattering. The surface
+    /// is taken as its tangent plane at the point nearest to the middle of a cell of the segment (cells
+    /// 2r long); a cell's closest-point query runs when a photon first falls in it.
+    class SurfaceCuts {
+    public:
+        SurfaceCuts(const Scene& scene, const Ray& ray, double a, double b, double r) : scene_(scene), ray_(ray), a_(a) {
+            if (!scene.hasSurfaces() || !(b > a) || !(r > 0)) return;
+            // At most MaxCells cells along a segment: a longer one samples planes further apart.
+            constexpr int MaxCells = 256;
+            h_ = std::max(2 * r, (b - a) / MaxCells);
+            reach_ = r + 0.5 * h_;
+            count_ = std::min(MaxCells, static_cast<int>(std::ceil((b - a) / h_)));
+        }
+        /// The fraction of the disc of radius r around the ray point at t that lies on the ray's side of
+        /// the nearest surface (1 where none is within r).
+        double inside(double t, double r) {
+            if (count_ == 0) return 1.0;
+            if (cells_.empty()) cells_.resize(count_);
+            int k = std::clamp(static_cast<int>((t - a_) / h_), 0, count_ - 1);
+            Cell& c = cells_[k];
+            if (!c.known) {
+                c.known = true;
+                if (std::optional<Scene::NearestSurface> s = scene_.nearestSurface(ray_.at(a_ + (k + 0.5) * h_), reach_)) {
+                    c.cut = true;
+                    c.p = s->p;
+                    c.towards = s->towards;
+                }
+            }
+            if (!c.cut) return 1.0;
+            // The plane meets the disc (normal d) in a line at distance delta / sin(angle(n, d)) from
+            // its centre; a disc parallel to the plane is not cut unless it lies beyond it.
+            double delta = dot(c.towards, ray_.at(t) - c.p), cosN = dot(c.towards, ray_.d);
+            double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
+            if (!(sinN * r > delta)) return delta < 0 ? 0.5 : 1.0;
+            return discFractionInside(delta / sinN, r);
+        }
+
+    private:
+        struct Cell {
+            bool known = false, cut = false;
+            Vec3 p, towards;
+        };
+        const Scene& scene_;
+        Ray ray_;
+        double a_, h_ = 0, reach_ = 0;
+        int count_ = 0;
+        std::vector<Cell> cells_;
+    };
+
+    Spectrum gather(const Ray& ray, double a, double b, const SegmentTransmittance& tr, const MediumStack& stack,
+                    SurfaceCuts cuts) const {
         Spectrum sum;
         int region = stack.innermost();
         map_->query(ray, a, b, [&](const Photon& ph, double t, double) {
             if (ph.region != region) return;
-            double invArea = 1 / (Pi * double(ph.radius) * ph.radius);
+            double invArea = 1 / (Pi * double(ph.radius) * ph.radius * cuts.inside(t, ph.radius));
             double cosTheta = -(ph.dir[0] * ray.d.x + ph.dir[1] * ray.d.y + ph.dir[2] * ray.d.z);
             double p = ph.phase->eval(std::clamp(cosTheta, -1.0, 1.0));
             sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * tr.at(t) * (p * invArea);

@@ -322,6 +322,83 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
     return true;
 }
 
+namespace {
+
+/// The point of triangle abc nearest to p, by the Voronoi region of p among the triangle's vertices,
+/// edges and face (Ericson, "Real-Time Collision Detection", 2005, section 5.1.5).
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+    Vec3 ab = b - a, ac = c - a, ap = p - a;
+    double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    Vec3 bp = p - b;
+    double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+    Vec3 cp = p - c;
+    double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    double denom = va + vb + vc;
+    if (!(std::abs(denom) > 0)) return a;  // degenerate triangle: its vertices and edges were tried
+    return a + ab * (vb / denom) + ac * (vc / denom);
+}
+
+struct NearestQuery {
+    const SceneDesc* desc;
+    Vec3 p;
+    double best;
+    std::optional<Scene::NearestSurface> found;
+};
+
+bool nearestTriangle(RTCPointQueryFunctionArguments* args) {
+    auto* q = static_cast<NearestQuery*>(args->userPtr);
+    // An instanced mesh's triangle names its instance on the context's stack; a flattened one is
+    // geometry `instance` of the top-level scene (as in Scene::intersect).
+    unsigned inst = args->context->instStackSize > 0 ? args->context->instID[0] : args->geomID;
+    const InstanceDesc& id = q->desc->instances[inst];
+    const MeshDesc& m = q->desc->meshes[id.mesh];
+    const uint32_t* tri = &m.indices[3 * size_t(args->primID)];
+    Vec3 a = id.transform.point(m.points[tri[0]]), b = id.transform.point(m.points[tri[1]]),
+         c = id.transform.point(m.points[tri[2]]);
+    Vec3 x = closestPointOnTriangle(q->p, a, b, c);
+    double d = length(q->p - x);
+    if (!(d < q->best)) return false;
+    q->best = d;
+    Vec3 towards = q->p - x;
+    if (d > 0) {
+        towards = towards / d;
+    } else {
+        towards = cross(b - a, c - a);
+        double l = length(towards);
+        towards = l > 0 ? towards / l : Vec3(0, 0, 1);
+    }
+    q->found = Scene::NearestSurface{x, towards, d};
+    // Shrink the search to what was found (rounded up: the float radius must not cut it off).
+    args->query->radius = std::nextafter(static_cast<float>(d), std::numeric_limits<float>::infinity());
+    return true;
+}
+
+}  // namespace
+
+std::optional<Scene::NearestSurface> Scene::nearestSurface(const Vec3& p, double maxDistance) const {
+    if (desc_.instances.empty() || !isFinite(p) || !(maxDistance > 0)) return std::nullopt;
+    RTCPointQuery query;
+    query.x = static_cast<float>(p.x);
+    query.y = static_cast<float>(p.y);
+    query.z = static_cast<float>(p.z);
+    query.time = 0;
+    query.radius = static_cast<float>(std::min(maxDistance, 1e30));
+    RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    NearestQuery q{&desc_, p, maxDistance, std::nullopt};
+    rtcPointQuery(top_, &query, &ctx, nearestTriangle, &q);
+    return q.found;
+}
+
 MediumAggregate Scene::mediaFor(const MediumStack& stack) const {
     MediumAggregate agg;
 #ifdef VOLPHOTON_NO_VOLUMES

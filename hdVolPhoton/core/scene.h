@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,6 +127,15 @@ public:
     double exitDistance(int mesh, const Ray& ray) const;
     /// Stack of closed dielectric/boundary meshes containing p, found by parity along a probe ray.
     MediumStack stackAt(const Vec3& p) const;
+    /// The surface point nearest to a point, and the unit vector from it towards the point (the
+    /// geometric normal, turned towards the point, when the point lies on the surface).
+    struct NearestSurface {
+        Vec3 p, towards;
+        double distance = 0;
+    };
+    /// The nearest point of any surface within `maxDistance` of p (Embree's closest-point query over
+    /// the instanced triangles, distances in double in world space), or nothing.
+    std::optional<NearestSurface> nearestSurface(const Vec3& p, double maxDistance) const;
 
     const SceneDesc& desc() const { return desc_; }
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }

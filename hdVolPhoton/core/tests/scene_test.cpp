@@ -363,6 +363,42 @@ TEST(SceneInstancing, SingleInstanceMeshesAreFlattenedWithTheSameHits) {
     EXPECT_FALSE(scene.intersect({Vec3(0, 0, 5), Vec3(0, 1, 0)}, 0, Infinity, &hit));
 }
 
+TEST(SceneInstancing, NearestSurfaceMatchesTheBoxDistanceForFlatAndInstancedMeshes) {
+    // A unit box instanced twice (an Embree instance, one of them stretched: no similarity transform)
+    // and once more as its own mesh (flattened into the top-level scene): the nearest surface point of
+    // random points inside and outside is the exact distance to the nearest box, in double.
+    SceneDesc d;
+    d.meshes.push_back(test::boxMesh("shared", Vec3(0, 0, 0), Vec3(1, 1, 1)));
+    d.meshes.push_back(test::boxMesh("single", Vec3(0, 0, 0), Vec3(1, 1, 1)));
+    const Bounds3 boxes[3] = {{Vec3(-4, 0, 0), Vec3(-3, 1, 1)}, {Vec3(3, 0, 0), Vec3(6, 0.5, 1)}, {Vec3(0, 4, 0), Vec3(1, 5, 1)}};
+    d.instances.push_back({0, Affine::translate(boxes[0].lo)});
+    d.instances.push_back({0, Affine::translate(boxes[1].lo) * Affine::scale(Vec3(3, 0.5, 1))});
+    d.instances.push_back({1, Affine::translate(boxes[2].lo)});
+    Scene scene(d);
+    auto boxDistance = [](const Bounds3& b, const Vec3& p) {
+        if (b.contains(p)) return std::min({p.x - b.lo.x, b.hi.x - p.x, p.y - b.lo.y, b.hi.y - p.y, p.z - b.lo.z, b.hi.z - p.z});
+        Vec3 q = vmin(vmax(p, b.lo), b.hi);
+        return length(p - q);
+    };
+    Rng rng(1234);
+    int found = 0;
+    for (int i = 0; i < 2000; ++i) {
+        Vec3 p(-6 + 14 * rng.uniform(), -2 + 9 * rng.uniform(), -2 + 5 * rng.uniform());
+        double expected = std::min({boxDistance(boxes[0], p), boxDistance(boxes[1], p), boxDistance(boxes[2], p)});
+        const double reach = 1.5;
+        std::optional<Scene::NearestSurface> s = scene.nearestSurface(p, reach);
+        ASSERT_EQ(s.has_value(), expected < reach) << p.x << " " << p.y << " " << p.z;
+        if (!s) continue;
+        ++found;
+        EXPECT_NEAR(s->distance, expected, 1e-12);
+        EXPECT_NEAR(length(p - s->p), expected, 1e-12);
+        EXPECT_NEAR(length(s->towards), 1.0, 1e-12);
+        if (expected > 1e-9) EXPECT_NEAR(length(s->p + s->towards * s->distance - p), 0.0, 1e-9);
+    }
+    EXPECT_GT(found, 300);  // both branches are exercised
+    EXPECT_FALSE(Scene(SceneDesc()).nearestSurface(Vec3(0, 0, 0), 10));
+}
+
 TEST(SceneMedia, NestedMediaAndCameraInsideAClosedMesh) {
     SceneDesc d;
     d.media.push_back(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(0.5, Spectrum(1.0), Spectrum(0.5), Spectrum(0.0), makeIsotropicPhase())));
