@@ -151,6 +151,49 @@ void Integrator::firstVertexGuides(const Ray& cameraRay, double nearClip, double
     }
 }
 
+IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings) {
+    using I = RenderSettings::Integrator;
+    if (!scene.hasMedia()) return {I::PathTracer, "the scene has no media"};
+    // Which camera rays first meet a translucent object, and which cross a medium on the way.
+    constexpr int PilotW = 32, PilotH = 24;
+    const CameraDesc& cd = scene.desc().camera;
+    Camera camera(cd, std::max(1, settings.width), std::max(1, settings.height));
+    MediumStack cameraStack = scene.stackAt(camera.position());
+    MediumAggregate cameraMedia = scene.mediaFor(cameraStack);
+    int translucent = 0, media = 0;
+    for (int j = 0; j < PilotH; ++j)
+        for (int i = 0; i < PilotW; ++i) {
+            double tMin, tMax;
+            Ray ray = camera.generateRay((i + 0.5) * camera.width() / PilotW, (j + 0.5) * camera.height() / PilotH, 0.5, 0.5,
+                                         &tMin, &tMax);
+            SurfaceHit hit;
+            bool hasHit = scene.intersect(ray, tMin, tMax, &hit);
+            double tEnd = hasHit ? hit.t : std::min(tMax, 1e30);
+            bool crossesMedia = false;
+            if (cameraMedia.size())
+                cameraMedia.majorants(ray, tMin, tEnd, [&](const MajorantSegment& seg) {
+                    crossesMedia |= seg.sigmaMaj > 0;
+                    return !crossesMedia;
+                });
+            media += crossesMedia;
+            if (hasHit) {
+                const MeshDesc& m = scene.mesh(hit.mesh);
+                translucent += scene.meshClosed(hit.mesh) && m.material.kind == SurfaceMaterial::Kind::Dielectric &&
+                               m.interiorMedium >= 0 && !cameraStack.contains(hit.mesh);
+            }
+        }
+    auto percent = [](int n) { return std::to_string((100 * n + PilotW * PilotH / 2) / (PilotW * PilotH)) + "%"; };
+    std::string view = "translucent objects cover " + percent(translucent) + " of the view, open media " + percent(media);
+    bool deltaLight = false;
+    for (const LightPtr& l : scene.lights()) deltaLight |= l->isDelta();
+    if (translucent > 0 && deltaLight)
+        return {I::PhotonMap, view + "; a point, spot or sharp distant light reaches inside translucent objects only as photons",
+                true};
+    if (translucent > media)
+        return {I::PhotonMap, view + "; the photon map leads the path tracer on translucent objects"};
+    return {I::PathTracer, view + "; the path tracer leads on open media"};
+}
+
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> photonCache)
     : scene_(std::move(scene)), settings_(settings), film_(settings.width, settings.height) {
     if (settings_.samplesPerPixel < 0) throw std::invalid_argument("render settings: samplesPerPixel must be >= 0");
@@ -164,6 +207,19 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     active_.assign(static_cast<size_t>(settings_.width) * settings_.height, 1);
     stats_.activePixels = active_.size();
     bool photonMap = settings_.integrator == RenderSettings::Integrator::PhotonMap;
+    if (settings_.integrator == RenderSettings::Integrator::Auto) {
+        IntegratorChoice choice = chooseIntegrator(*scene_, settings_);
+        photonMap = choice.integrator == RenderSettings::Integrator::PhotonMap;
+        stats_.integratorReason = choice.reason;
+    } else if (!photonMap && scene_->hasMedia()) {
+        // The path tracer cannot carry a delta light's light through a refracting surface (shadow
+        // rays stop at dielectrics): say so rather than render translucent objects without it.
+        IntegratorChoice choice = chooseIntegrator(*scene_, settings_);
+        if (choice.photonsOnly)
+            warn("pathTracer integrator: " + choice.reason.substr(0, choice.reason.find(';')) +
+                 ", and the light of point, spot and sharp distant lights reaches inside them only as photons: it is "
+                 "missing there (use integrator photonMap or auto, or lights with extent)");
+    }
     if (photonMap && !scene_->hasMedia()) {
         // Without media the photon map has nothing to add: both of its passes would be skipped and its
         // camera paths (light sampling only, no MIS) are noisier than the path tracer's on the same
@@ -174,6 +230,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.passesSkipped.push_back("photon-map camera paths: the scene has no media, so the path tracer renders it");
     }
     usesPhotons_ = photonMap;
+    stats_.integratorUsed = photonMap ? "photonMap" : "pathTracer";
     integrator_ = photonMap ? makePhotonMapper(*scene_, settings_, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");

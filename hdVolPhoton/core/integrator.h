@@ -3,7 +3,8 @@
 // Render settings (the Hydra delegate exposes the same names as render-setting descriptors):
 // | name                | type   | default    | units        | meaning                                          |
 // |---------------------|--------|------------|--------------|--------------------------------------------------|
-// | integrator          | enum   | pathTracer |              | pathTracer (unbiased) or photonMap                |
+// | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, or auto: one of |
+// |                     |        |            |              | them per scene by a pilot (chooseIntegrator)      |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
 // |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
@@ -102,7 +103,8 @@
 namespace volphoton {
 
 struct RenderSettings {
-    enum class Integrator { PathTracer, PhotonMap };
+    /// Auto: one of the two, chosen per scene by a pilot of camera rays (chooseIntegrator).
+    enum class Integrator { PathTracer, PhotonMap, Auto };
     Integrator integrator = Integrator::PathTracer;
     int width = 640, height = 360;
     int samplesPerPixel = 16;
@@ -162,8 +164,26 @@ struct RenderStats {
     std::string stopReason;
     std::vector<std::string> passesRun;
     std::vector<std::string> passesSkipped;  ///< "name: reason"
+    /// The integrator that renders ("pathTracer" / "photonMap") and, for integrator = auto, why.
+    std::string integratorUsed, integratorReason;
     bool cancelled = false;
 };
+
+/// What integrator = auto renders a scene with, and why (RenderStats::integratorReason).
+struct IntegratorChoice {
+    RenderSettings::Integrator integrator;
+    std::string reason;
+    /// Translucent objects in view and a delta light: the path tracer would miss that light inside.
+    bool photonsOnly = false;
+};
+/// integrator = auto: a pilot of 32 x 24 camera rays through the image finds what the view is made of:
+/// translucent objects (closed dielectric meshes with a medium inside, which next-event estimation
+/// cannot reach), open media, or neither. The photon map renders views where translucent objects
+/// cover more than open media (it leads the path tracer at equal time on both subsurface
+/// benchmark scenes), and any translucent object under a delta light (point, spot, sharp distant),
+/// whose light reaches the inside through the refracting surface only as photons; the path tracer
+/// renders the rest (it leads on every open-media benchmark scene, tools/bench/README.md).
+IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;
 using CancelCallback = std::function<bool()>;

@@ -420,7 +420,7 @@ private:
     /// 2r long); a cell's closest-point query runs when a photon first falls in it.
     class SurfaceCuts {
     public:
-        SurfaceCuts(const Scene& scene, const Ray& ray, double a, double b, double r) : scene_(scene), ray_(ray), a_(a) {
+        SurfaceCuts(const Scene& scene, const Ray& ray, double a, double b, double r) : scene_(scene), ray_(ray), a_(a), b_(b) {
             if (!scene.hasSurfaces() || !(b > a) || !(r > 0)) return;
             // At most MaxCells cells along a segment: a longer one samples planes further apart.
             constexpr int MaxCells = 256;
@@ -437,7 +437,10 @@ private:
             Cell& c = cells_[k];
             if (!c.known) {
                 c.known = true;
-                if (std::optional<Scene::NearestSurface> s = scene_.nearestSurface(ray_.at(a_ + (k + 0.5) * h_), reach_)) {
+                // The middle of the cell's part of the segment: a point on the segment's side of the
+                // surfaces (a cell reaching past the segment's end would look from beyond a surface).
+                double mid = 0.5 * (a_ + k * h_ + std::min(b_, a_ + (k + 1) * h_));
+                if (std::optional<Scene::NearestSurface> s = scene_.nearestSurface(ray_.at(mid), reach_)) {
                     c.cut = true;
                     c.p = s->p;
                     c.towards = s->towards;
@@ -445,10 +448,11 @@ private:
             }
             if (!c.cut) return 1.0;
             // The plane meets the disc (normal d) in a line at distance delta / sin(angle(n, d)) from
-            // its centre; a disc parallel to the plane is not cut unless it lies beyond it.
+            // its centre; a disc parallel to the plane is not cut. A ray point behind the plane
+            // (a curved or another surface there) is left uncorrected rather than guessed.
             double delta = dot(c.towards, ray_.at(t) - c.p), cosN = dot(c.towards, ray_.d);
             double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
-            if (!(sinN * r > delta)) return delta < 0 ? 0.5 : 1.0;
+            if (!(sinN * r > delta) || delta < 0) return 1.0;
             return discFractionInside(delta / sinN, r);
         }
 
@@ -459,7 +463,7 @@ private:
         };
         const Scene& scene_;
         Ray ray_;
-        double a_, h_ = 0, reach_ = 0;
+        double a_, b_, h_ = 0, reach_ = 0;
         int count_ = 0;
         std::vector<Cell> cells_;
     };

@@ -20,7 +20,7 @@ class HdVolPhotonRenderParam;
 /// Render settings (descriptors; the same meanings as hdVolPhoton/core/integrator.h):
 /// | key                          | type  | default    | meaning                                      |
 /// |------------------------------|-------|------------|----------------------------------------------|
-/// | volphoton:integrator         | string| pathTracer | pathTracer or photonMap (a token too)        |
+/// | volphoton:integrator         | string| pathTracer | pathTracer, photonMap or auto (a token too)  |
 /// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes of a batch   |
 /// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |

@@ -63,6 +63,8 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
             if (s == "multiple scattering (photons): disabled by settings")
                 s = "multiple scattering (photons): no bound AOV shows it (color, multiple, surface)";
     d["passesSkipped"] = VtValue(skipped);
+    d["integratorUsed"] = VtValue(_stats.integratorUsed);
+    d["integratorReason"] = VtValue(_stats.integratorReason);
     d["framesWritten"] = VtValue(_framesWritten);
     d["previewBlock"] = VtValue(_previewBlock);
     d["activePixels"] = VtValue(static_cast<uint64_t>(_stats.activePixels));

@@ -41,6 +41,8 @@ py::dict statsToDict(const RenderStats& s) {
     d["photons_radius_capped"] = s.photonsRadiusCapped;
     d["passes_run"] = s.passesRun;
     d["passes_skipped"] = s.passesSkipped;
+    d["integrator_used"] = s.integratorUsed;
+    d["integrator_reason"] = s.integratorReason;
     d["cancelled"] = s.cancelled;
     d["active_pixels"] = s.activePixels;
     d["median_relative_error"] = s.medianRelativeError;
@@ -184,7 +186,8 @@ void bindRender(py::module_& m) {
     py::class_<RenderSettings> rs(m, "RenderSettings");
     py::enum_<RenderSettings::Integrator>(rs, "Integrator")
         .value("PathTracer", RenderSettings::Integrator::PathTracer)
-        .value("PhotonMap", RenderSettings::Integrator::PhotonMap);
+        .value("PhotonMap", RenderSettings::Integrator::PhotonMap)
+        .value("Auto", RenderSettings::Integrator::Auto);
     rs.def(py::init<>())
         .def_readwrite("integrator", &RenderSettings::integrator)
         .def_readwrite("width", &RenderSettings::width)

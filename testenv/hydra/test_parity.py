@@ -454,6 +454,56 @@ def test_emissive_geometry_lights_media_in_both_doors(tmp_path, hydra_env, integ
     assert_doors_agree(hydra, cli, "fog under an emissive panel (%s)" % integrator)
 
 
+# A cube of dense medium lit by a small sphere light: translucent behind an n = 1.3 surface, or open.
+AUTO_CUBE = '''    def Cube "marble" (
+        prepend apiSchemas = ["VolPhotonMediumAPI"]
+    )
+    {
+        double size = 1.6
+        float volphoton:density = 8
+        color3f volphoton:albedo = (0.99, 0.97, 0.95)
+%(ior)s    }
+
+    def SphereLight "lamp"
+    {
+        float inputs:intensity = 30
+        float inputs:radius = 0.3
+        double3 xformOp:translate = (1.5, 2, 1.5)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+'''
+
+
+@pytest.mark.parametrize("translucent,chosen", [(True, "photonMap"), (False, "pathTracer")])
+def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_env, translucent, chosen):
+    """integrator = auto (core chooseIntegrator): the pilot sees a translucent cube filling the middle
+    of the view (a dielectric with a medium inside) and picks the photon map, or the same cube as an
+    open medium and picks the path tracer.  In each door the auto image is bit-identical to the one
+    rendered with the chosen integrator named, and the two doors agree."""
+    body = AUTO_CUBE % {"ior": "        float volphoton:ior = 1.3\n" if translucent else ""}
+    images = {}
+    jobs, outs = [], []
+    for integrator in ("auto", chosen):
+        stage = tmp_path / ("%s.usda" % integrator)
+        stage.write_text(stage_text(body, 1, settings=['token volphoton:integrator = "%s"' % integrator, PHOTONS]))
+        for door in ("hydra", "cli"):
+            out = str(tmp_path / ("%s.%s.exr" % (integrator, door)))
+            outs.append(((integrator, door), out))
+            if door == "hydra":
+                jobs.append(lambda s=str(stage), o=out: render_hydra(hydra_env, s, o, W))
+            else:
+                jobs.append(lambda s=str(stage), o=out: render_cli(s, o))
+    logs = run_parallel(jobs)
+    for (key, out), log in zip(outs, logs):
+        assert os.path.exists(out), (key, log[-2000:])
+        images[key] = rgb(out)
+    for door in ("hydra", "cli"):
+        check(np.array_equal(images["auto", door], images[chosen, door]),
+              "%s: auto did not render as %s (max difference %.3g)"
+              % (door, chosen, np.abs(images["auto", door] - images[chosen, door]).max()))
+    check(images["auto", "cli"].mean() > 0.01, "the cube is not lit: mean %.4f" % images["auto", "cli"].mean())
+
+
 # The same panel as a UsdLux mesh light (no material: the light's colour is the emission).
 MESH_LIGHT_PANEL = EMISSIVE_PANEL[:EMISSIVE_PANEL.index('    def Material "glow"')] + '''    def Mesh "panel" (
         prepend apiSchemas = ["MeshLightAPI"]

@@ -3,6 +3,7 @@
 // below 1e-4 under a normal approximation), or k = 4 for single-number checks.
 #include <gtest/gtest.h>
 
+#include "core/diagnostics.h"
 #include "core/exponentialMedium.h"
 #include "core/gridMedium.h"
 #include "core/homogeneousMedium.h"
@@ -555,6 +556,88 @@ TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     auto a = imageMean(d, pt, [](const Film& f) { return aovMean(f, Film::Beauty); });
     auto b = imageMean(d, pm, [](const Film& f) { return aovMean(f, Film::Beauty); });
     EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_) + 0.02 * a.mean);
+}
+
+TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTracerForOpenMedia) {
+    // integrator = auto (chooseIntegrator): a translucent box (dielectric, medium inside) filling the
+    // view under a dome -> photon map; the same box behind a fog box that covers the view -> path
+    // tracer (a tie goes to the unbiased one); a small translucent box alone in the view under a
+    // point light or a sphere light -> photon map (only photons reach inside a point-lit one); fog
+    // around the small box -> path tracer unless the light is a point; no media -> path tracer. The Renderer reports the choice and the reason in its stats.
+    auto marble = MediumCoefficients::fromAlbedo(20.0, Spectrum(1.0), Spectrum(0.99), Spectrum(0.0), makeIsotropicPhase());
+    auto translucentBox = [&](SceneDesc& d, double half) {
+        d.media.push_back(std::make_shared<HomogeneousMedium>(marble, Bounds3{Vec3(-half, -half, -half), Vec3(half, half, half)}));
+        MeshDesc box = test::boxMesh("marble", Vec3(-half, -half, -half), Vec3(half, half, half));
+        box.material.kind = SurfaceMaterial::Kind::Dielectric;
+        box.material.ior = 1.3;
+        box.interiorMedium = static_cast<int>(d.media.size()) - 1;
+        d.meshes.push_back(box);
+        d.instances.push_back({static_cast<int>(d.meshes.size()) - 1, Affine()});
+    };
+    RenderSettings s = smallSettings(RenderSettings::Integrator::Auto, 1, 0);
+    auto choose = [&](const SceneDesc& d) { return chooseIntegrator(Scene(d), s); };
+    using I = RenderSettings::Integrator;
+
+    SceneDesc filled;
+    translucentBox(filled, 1.0);
+    filled.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    filled.camera = lookAt(Vec3(0, 0, 2.5), Vec3(0, 0, 0), 0.3);
+    IntegratorChoice c = choose(filled);
+    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_NE(c.reason.find("translucent objects cover 100% of the view"), std::string::npos) << c.reason;
+
+    SceneDesc fogged = filled;
+    fogged.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(0.5, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeIsotropicPhase()),
+        Bounds3{Vec3(-5, -5, 1.5), Vec3(5, 5, 2)}));
+    fogged.unboundedMedia.push_back(static_cast<int>(fogged.media.size()) - 1);
+    c = choose(fogged);
+    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_NE(c.reason.find("open media 100%"), std::string::npos) << c.reason;
+
+    SceneDesc small;
+    translucentBox(small, 0.05);
+    small.lights.push_back(makeSphereLight(Vec3(0, 2, 0), 0.0, Spectrum(1.0)));
+    small.camera = filled.camera;
+    c = choose(small);
+    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_NE(c.reason.find("only as photons"), std::string::npos) << c.reason;
+    small.lights[0] = makeSphereLight(Vec3(0, 2, 0), 0.5, Spectrum(1.0));
+    EXPECT_EQ(choose(small).integrator, I::PhotonMap) << choose(small).reason;
+    small.media.push_back(fogged.media.back());
+    small.unboundedMedia.push_back(static_cast<int>(small.media.size()) - 1);
+    c = choose(small);
+    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_NE(c.reason.find("translucent objects cover 1% of the view, open media 100%"), std::string::npos) << c.reason;
+    small.lights[0] = makeSphereLight(Vec3(0, 2, 0), 0.0, Spectrum(1.0));
+    EXPECT_EQ(choose(small).integrator, I::PhotonMap) << choose(small).reason;
+    // The path tracer, asked for by name there, says what it cannot render (and only there).
+    auto warnings = [](const SceneDesc& d, RenderSettings rs) {
+        std::vector<std::string> messages;
+        setDiagnosticSink([&](Severity, const std::string& m) { messages.push_back(m); });
+        Renderer renderer(std::make_shared<Scene>(d), rs);
+        setDiagnosticSink({});
+        int n = 0;
+        for (const std::string& m : messages) n += m.find("pathTracer integrator: translucent objects cover") != std::string::npos;
+        return n;
+    };
+    RenderSettings pt = smallSettings(I::PathTracer, 1, 0);
+    EXPECT_EQ(warnings(small, pt), 1);
+    EXPECT_EQ(warnings(small, s), 0);
+    EXPECT_EQ(warnings(filled, pt), 0);
+
+    SceneDesc bare;
+    bare.meshes.push_back(test::boxMesh("box", Vec3(-1, -1, -1), Vec3(1, 1, 1)));
+    bare.instances.push_back({0, Affine()});
+    bare.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    bare.camera = filled.camera;
+    EXPECT_EQ(choose(bare).integrator, I::PathTracer);
+
+    Renderer r(std::make_shared<Scene>(filled), s);
+    EXPECT_EQ(r.stats().integratorUsed, "photonMap");
+    EXPECT_EQ(r.stats().integratorReason, choose(filled).reason);
+    Renderer r2(std::make_shared<Scene>(fogged), s);
+    EXPECT_EQ(r2.stats().integratorUsed, "pathTracer");
 }
 
 TEST(IntegratorAovs, BeautyIsTheSumOfTheSplit) {

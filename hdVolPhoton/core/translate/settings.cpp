@@ -45,9 +45,10 @@ std::vector<SettingInfo> makeTable() {
     using RS = RenderSettings;
     constexpr double Big = 1e9;
     std::vector<SettingInfo> t;
-    t.push_back({"integrator", SettingType::Choice, 0, 0, {"pathTracer", "photonMap"}, "--integrator",
+    t.push_back({"integrator", SettingType::Choice, 0, 0, {"pathTracer", "photonMap", "auto"}, "--integrator",
                  "volphoton:integrator", "Integrator", "",
-                 "pathTracer (unbiased volumetric path tracer) or photonMap (single-scattering march + volume photon map)",
+                 "pathTracer (unbiased volumetric path tracer), photonMap (single-scattering march + volume photon map) "
+                 "or auto (one of them per scene from a pilot of camera rays; the stats say which and why)",
                  [](const RS& s) { return AttrValue(integratorName(s.integrator)); },
                  [](RS& s, const AttrValue& v) { parseIntegrator(std::get<std::string>(v), &s.integrator); }});
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
@@ -126,12 +127,17 @@ const SettingInfo* findSetting(const std::string& name) {
 }
 
 std::string integratorName(RenderSettings::Integrator i) {
-    return i == RenderSettings::Integrator::PhotonMap ? "photonMap" : "pathTracer";
+    switch (i) {
+    case RenderSettings::Integrator::PhotonMap: return "photonMap";
+    case RenderSettings::Integrator::Auto: return "auto";
+    default: return "pathTracer";
+    }
 }
 
 bool parseIntegrator(const std::string& text, RenderSettings::Integrator* out) {
     if (text == "pathTracer" || text == "pathtracer") return *out = RenderSettings::Integrator::PathTracer, true;
     if (text == "photonMap" || text == "photonmap") return *out = RenderSettings::Integrator::PhotonMap, true;
+    if (text == "auto") return *out = RenderSettings::Integrator::Auto, true;
     return false;
 }
 

@@ -44,7 +44,7 @@ const SettingInfo* findSetting(const std::string& name);
 bool applySetting(RenderSettings& settings, const std::string& name, const AttrValue& value,
                   Diagnostics& diagnostics, const std::string& prim = "");
 
-/// The integrator's name as a setting value ("pathTracer" / "photonMap"), and back; parseIntegrator
+/// The integrator's name as a setting value ("pathTracer" / "photonMap" / "auto"), and back; parseIntegrator
 /// also takes the CLI's lower-case spellings. False for anything else.
 std::string integratorName(RenderSettings::Integrator integrator);
 bool parseIntegrator(const std::string& text, RenderSettings::Integrator* out);

@@ -285,7 +285,9 @@ def _integrator(text: str) -> str:
         return "pathTracer"
     if t in ("photonmap", "pm", "photonmapper"):
         return "photonMap"
-    raise argparse.ArgumentTypeError("unknown integrator %r (pathtracer or photonmap)" % text)
+    if t == "auto":
+        return "auto"
+    raise argparse.ArgumentTypeError("unknown integrator %r (pathtracer, photonmap or auto)" % text)
 
 
 def _core_settings_table(core=None):
@@ -525,10 +527,10 @@ def cmd_render(args) -> int:
 
 
 def _photon_cache(core, usdscene, stage, settings, frames, reporter, quiet):
-    """One PhotonCache for the whole frame range when photons can be reused: the photon map integrator,
+    """One PhotonCache for the whole frame range when photons can be reused: the photon map integrator (or auto),
     several frames, and nothing but cameras animated (usdscene.first_time_varying_content). Reused
     passes are bit-identical to traced ones, so every frame is the image it would be on its own."""
-    if len(frames) < 2 or settings.to_dict()["integrator"] != "photonMap":
+    if len(frames) < 2 or settings.to_dict()["integrator"] not in ("photonMap", "auto"):
         return None
     varying = usdscene.first_time_varying_content(stage)
     if varying:
@@ -609,7 +611,7 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
     reused = rstats["photon_passes_reused"]
     reporter.info("%s: %dx%d, %d passes (%s), median estimated error %s, %s%s, %.2f s -> %s%s" % (
         "frame %d" % frame if frame is not None else "rendered", settings.width, settings.height, rstats["passes"], _STOP_REASONS.get(rstats["stop_reason"], "?"),
-        "%.1f%%" % (100 * error) if error >= 0 else "n/a", settings.to_dict()["integrator"],
+        "%.1f%%" % (100 * error) if error >= 0 else "n/a", _integrator_summary(settings, rstats),
         " (photon maps of %d pass%s reused)" % (reused, "" if reused == 1 else "es") if reused else "",
         t4 - t0, exr_path, (", " + png_path) if png_path else ""))
     if index == 0 and not args.quiet:
@@ -648,6 +650,8 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "stop_reason": rstats["stop_reason"],
             "passes_run": rstats["passes_run"],
             "passes_skipped": rstats["passes_skipped"],
+            "integrator_used": rstats["integrator_used"],
+            "integrator_reason": rstats["integrator_reason"],
         },
         "peak_rss_bytes": _peak_rss_bytes(),
         "diagnostics": {"errors": counts["error"], "warnings": counts["warning"],
@@ -657,6 +661,13 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
 
 _STOP_REASONS = {"samplesPerPixel": "all samples", "noiseTarget": "noise target met",
                  "timeLimit": "time limit", "maxSamplesPerPixel": "sample cap (--max-spp)"}
+
+
+def _integrator_summary(settings, rstats) -> str:
+    """The integrator that rendered; with integrator = auto, the choice and why."""
+    if settings.to_dict()["integrator"] == "auto":
+        return "auto: %s (%s)" % (rstats["integrator_used"], rstats["integrator_reason"])
+    return rstats["integrator_used"]
 
 
 def _isfinite(a):
