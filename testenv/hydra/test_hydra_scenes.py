@@ -200,12 +200,13 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     """volphoton:integrator on a RenderSettings prim selects the integrator whether authored as a
     token or as a string (the delegate's descriptor is a string so usdview's dialog can edit it):
     the two spellings render bit-identically, "pathTracer" as the default does, and "photonMap"
-    differently (the photon map's passes draw other random numbers)."""
+    differently (the photon map's passes draw other random numbers), "auto" as the path tracer here."""
     variants = {"default": "", "pathTracerToken": 'token volphoton:integrator = "pathTracer"',
                 "pathTracerString": 'string volphoton:integrator = "pathTracer"',
                 "photonMapToken": 'token volphoton:integrator = "photonMap"',
                 "photonMapString": 'string volphoton:integrator = "photonMap"',
-                "misspelt": 'token volphoton:integrator = "photonmapper"'}
+                "misspelt": 'token volphoton:integrator = "photonmapper"',
+                "auto": 'token volphoton:integrator = "auto"'}
     images, logs = _render_furnace_variants(tmp_path, hydra_env, variants,
                                             check_base=lambda base: "volphoton:integrator" not in base)
     assert np.array_equal(images["default"], images["pathTracerToken"])
@@ -215,5 +216,7 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     # Both integrators see the same white furnace (radiance 1), so the photon map is no broken image.
     assert abs(images["photonMapString"].mean() - 1) < 0.1, images["photonMapString"].mean()
     assert np.array_equal(images["default"], images["misspelt"])
-    assert "volphoton:integrator: unusable value 'photonmapper' (one of pathTracer, photonMap)" in logs["misspelt"], \
+    # auto: a furnace has no translucent object in view, so the path tracer renders it.
+    assert np.array_equal(images["default"], images["auto"])
+    assert "volphoton:integrator: unusable value 'photonmapper' (one of pathTracer, photonMap, auto)" in logs["misspelt"], \
         logs["misspelt"]
