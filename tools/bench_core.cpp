@@ -143,13 +143,10 @@ void pathTracerThroughput(bool quick) {
     RTCScene flat = rtcNewScene(device);
     rtcSetSceneFlags(flat, RTC_SCENE_FLAG_ROBUST);
     const MeshDesc& box = scene->desc().meshes[0];
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), box.points.size()));
-    for (size_t i = 0; i < box.points.size(); ++i)
-        for (int k = 0; k < 3; ++k) v[3 * i + k] = static_cast<float>(box.points[i][k]);
-    unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), box.indices.size() / 3));
-    std::copy(box.indices.begin(), box.indices.end(), idx);
-    rtcCommitGeometry(g);
+    std::vector<float> points;
+    for (const Vec3& p : box.points)
+        for (int k = 0; k < 3; ++k) points.push_back(static_cast<float>(p[k]));
+    RTCGeometry g = embreeTriangles(device, points.data(), box.points.size(), box.indices);
     rtcAttachGeometry(flat, g);
     rtcReleaseGeometry(g);
     rtcCommitScene(flat);

@@ -123,13 +123,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         return std::all_of(out->begin(), out->end(), [](float f) { return std::isfinite(f); });
     };
     auto triangles = [&](const MeshDesc& m, const std::vector<float>& points) {
-        RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.points.size()));
-        std::copy(points.begin(), points.end(), v);
-        unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.indices.size() / 3));
-        std::copy(m.indices.begin(), m.indices.end(), idx);
-        rtcCommitGeometry(g);
-        return g;
+        return embreeTriangles(device_, points.data(), m.points.size(), m.indices);
     };
     std::vector<float> points;
     meshScenes_.assign(desc_.meshes.size(), nullptr);
