@@ -104,7 +104,8 @@ def main(argv=None):
                 f.write(orbit_layer(scene, args.views, args.step, (w, h), timed))
             with open(ref_stage, "w") as f:
                 f.write(orbit_layer(scene, args.views, args.step, (w, h), reference))
-            common = ["--renderSettingsPrimPath", "/Render/settings", "--camera", "/World/camera", "--imageWidth", w]
+            common = ["--renderSettingsPrimPath", "/Render/settings", "--enableDomeLightVisibility", "--camera", "/World/camera",
+                      "--imageWidth", w]
             orbit_out = os.path.join(tmp, scene + ".orbit.#.exr")
             r = run_usdrecord(env, common + ["--frames", "1:%d" % args.views, timed_stage, orbit_out])
             assert r.returncode == 0, r.stdout + r.stderr

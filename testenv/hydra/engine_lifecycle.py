@@ -14,7 +14,7 @@ Exits 0 when every check holds; otherwise prints the failed check and exits 1. A
 import sys
 import time
 
-from pxr import CameraUtil, Gf, Sdf, Usd, UsdGeom, UsdImagingGL
+from pxr import CameraUtil, Gf, Glf, Sdf, Usd, UsdGeom, UsdImagingGL
 
 SIZE = (64, 36)
 QUIET = 0.5  # seconds a stopped or paused render must not advance
@@ -137,10 +137,20 @@ def main(scene, camera_path, light_path):
         render_until(lambda: passes() > 0 and engine.IsConverged())
         return stats()
 
+    def move_camera(degrees):
+        """Turns the camera, and moves the engine's camera light with it as usdview and usdrecord do
+        on every frame (a lighting-state light Sprim the delegate must not take for a scene edit)."""
+        f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), degrees)))
+        engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+        headlight = Glf.SimpleLight()
+        p = f.GetPosition()
+        headlight.position = Gf.Vec4f(p[0], p[1], p[2], 1.0)
+        engine.SetLightingState([headlight], Glf.SimpleMaterial(), Gf.Vec4f(0.1, 0.1, 0.1, 1.0))
+
+    move_camera(0.0)
     s = converged_stats()
     check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "photons traced first: %s" % s)
-    f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), -2.0)))
-    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    move_camera(-2.0)
     s = converged_stats()
     check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3 and s["photonsReused"] > 0,
           "a camera move reuses every photon pass: %s" % s)
@@ -155,8 +165,7 @@ def main(scene, camera_path, light_path):
     check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "a moved light traces photons: %s" % s)
     # Photons feed only the beauty, multiple and surface AOVs: a depth pass traces none.
     engine.SetRendererAov("depth")
-    f.Transform(Gf.Matrix4d().SetRotate(Gf.Rotation(Gf.Vec3d(0, 1, 0), 1.0)))
-    engine.SetCameraState(f.ComputeViewMatrix(), f.ComputeProjectionMatrix())
+    move_camera(1.0)
     s = converged_stats()
     check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 0 and
           any("no bound AOV" in x for x in s["passesSkipped"]), "a depth pass traces no photons: %s" % s)
