@@ -763,6 +763,35 @@ def test_render_settings_prim_and_priority(tmp_path):
     assert st["settings"]["maxDepth"] == 5 and st["settings"]["seed"] == 9
 
 
+@pytest.mark.parametrize("ior,chosen", [("1.3", "photonMap"), ("1", "pathTracer")])
+def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
+    """--integrator auto: a cube of dense medium filling the middle of the view, translucent behind an
+    n = 1.3 surface (the photon map) or an open medium (ior 1: the path tracer); the stats and the
+    log line say which integrator rendered and why (core chooseIntegrator)."""
+    stage, path = stage_from(tmp_path, """
+        def Cube "marble" (prepend apiSchemas = ["VolPhotonMediumAPI"]) {
+            double size = 1.6
+            float volphoton:density = 8
+            float volphoton:ior = %s
+        }
+        def SphereLight "lamp" { float inputs:radius = 0.3
+                                 double3 xformOp:translate = (1.5, 2, 1.5)
+                                 uniform token[] xformOpOrder = ["xformOp:translate"] }
+        def Camera "cam" { double3 xformOp:translate = (0, 0, 6)
+                           uniform token[] xformOpOrder = ["xformOp:translate"] }
+    """ % ior)
+    stats = tmp_path / "s.json"
+    r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "1",
+                "--integrator", "auto", "--photons", "2000")
+    assert r.returncode == 0, r.stderr
+    st = json.loads(stats.read_text())["frames"][0]
+    assert st["settings"]["integrator"] == "auto"
+    assert st["render"]["integrator_used"] == chosen
+    reason = st["render"]["integrator_reason"]
+    assert reason.startswith("translucent objects cover") and "of the view, open media" in reason, reason
+    assert "auto: %s (%s)" % (chosen, reason) in r.stderr + r.stdout
+
+
 # ------------------------------------------------------------------------------------------------
 # Frames, stats and the command's errors
 # ------------------------------------------------------------------------------------------------
