@@ -11,7 +11,6 @@ passes, another seed): RMSE of the orbit's frame / RMSE of the fresh one. Below 
     PATH=/opt/openusd/bin:$PATH python tools/bench_hydra_orbit.py     # 80x60, 2 s a view, 4 views
 """
 
-import argparse
 import math
 import os
 import subprocess
@@ -24,6 +23,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(REPO, "testenv", "hydra"))
 sys.path.insert(0, os.path.join(REPO, "testenv"))
 from hydra_util import make_hydra_env, run_usdrecord, volphoton_exe  # noqa: E402
+from bench_photon_reuse import orbit_arguments  # noqa: E402
 from volphoton import output  # noqa: E402
 
 SCENES = ["vdb_cloud", "fog_spotlight"]
@@ -78,13 +78,7 @@ def rgb(path):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--resolution", nargs=2, type=int, default=[80, 60])
-    ap.add_argument("--seconds", type=float, default=2.0)
-    ap.add_argument("--views", type=int, default=4)
-    ap.add_argument("--step", type=float, default=6.0, help="degrees between views")
-    ap.add_argument("--reference-passes", type=int, default=256)
-    args = ap.parse_args(argv)
+    args = orbit_arguments(__doc__.splitlines()[0], argv)
     w, h = args.resolution
     env = make_hydra_env()
     timed = ['token volphoton:integrator = "photonMap"', "float volphoton:timeLimit = %g" % args.seconds,

@@ -32,14 +32,19 @@ def orbit(camera_to_world, center, degrees):
     return out
 
 
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def orbit_arguments(description, argv):
+    """The orbit's options, shared with tools/bench_hydra_orbit.py (the same orbit through the delegate)."""
+    ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--resolution", nargs=2, type=int, default=[80, 60])
     ap.add_argument("--seconds", type=float, default=2.0)
     ap.add_argument("--views", type=int, default=4)
     ap.add_argument("--step", type=float, default=6.0, help="degrees between views")
     ap.add_argument("--reference-passes", type=int, default=256)
-    args = ap.parse_args(argv)
+    return ap.parse_args(argv)
+
+
+def main(argv=None):
+    args = orbit_arguments(__doc__.splitlines()[0], argv)
     w, h = args.resolution
     print("| scene | view | passes, reuse | passes, from scratch | photon passes reused | RMSE reuse / from scratch |")
     print("|---|---|---|---|---|---|")
