@@ -336,7 +336,8 @@ private:
             double beam = map_->radius(), a = std::max(0.0, supportStart - beam), b = std::min(length, supportEnd + beam);
             r.multiple = gather(ray, a, b, tr, stack, SurfaceCuts(scene_, ray, a, b, beam));
         } else if (beams_) {
-            r.multiple = gatherBeams(media, ray, supportStart, std::min(length, supportEnd), tr, stack);
+            double b = std::min(length, supportEnd);
+            r.multiple = gatherBeams(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, ray, supportStart, b, beams_->radius()));
         }
         return r;
     }
@@ -414,7 +415,8 @@ private:
     /// of one collects photons over the part of its area on that side: the count estimates f x the
     /// density, f the disc's fraction inside (1/2 at the surface). Each photon's contribution is divided
     /// by f at its ray point (the renormalisation correction of kernel density estimation at a boundary;
-    /// M. C. Jones 1993, "Simple boundary correction for kernel density estimation"). Without it a camera
+    /// M. C. Jones 1993, "Simple boundary correction for kernel density estimation"); a beam's 1D kernel
+    /// across the ray likewise by the part of its width inside (insideAcross). Without it a camera
     /// ray grazing the ground of benchmark scene 5 lost 29% of its blue multiple scattering. The surface
     /// is taken as its tangent plane at the point nearest to the middle of a cell of the segment (cells
     /// 2r long); a cell's closest-point query runs when a photon first falls in it.
@@ -431,7 +433,34 @@ private:
         /// The fraction of the disc of radius r around the ray point at t that lies on the ray's side of
         /// the nearest surface (1 where none is within r).
         double inside(double t, double r) {
-            if (count_ == 0) return 1.0;
+            const Cell* c = cell(t);
+            if (!c) return 1.0;
+            // The plane meets the disc (normal d) in a line at distance delta / sin(angle(n, d)) from
+            // its centre; a disc parallel to the plane is not cut. A ray point behind the plane
+            // (a curved or another surface there) is left uncorrected rather than guessed.
+            double delta = dot(c->towards, ray_.at(t) - c->p), cosN = dot(c->towards, ray_.d);
+            double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
+            if (!(sinN * r > delta) || delta < 0) return 1.0;
+            return discFractionInside(delta / sinN, r);
+        }
+        /// The same for a beam's 1D kernel: the fraction of the segment [-r, r] along the unit vector u
+        /// (across both the ray and the beam) around the ray point at t on the ray's side.
+        double insideAcross(double t, double r, const Vec3& u) {
+            const Cell* c = cell(t);
+            if (!c) return 1.0;
+            double delta = dot(c->towards, ray_.at(t) - c->p), nu = std::abs(dot(c->towards, u));
+            if (!(nu * r > delta) || delta < 0) return 1.0;
+            return 0.5 * (1 + delta / (nu * r));
+        }
+
+    private:
+        struct Cell {
+            bool known = false, cut = false;
+            Vec3 p, towards;
+        };
+        /// The cell holding t with its surface plane, or null where no surface is within reach.
+        const Cell* cell(double t) {
+            if (count_ == 0) return nullptr;
             if (cells_.empty()) cells_.resize(count_);
             int k = std::clamp(static_cast<int>((t - a_) / h_), 0, count_ - 1);
             Cell& c = cells_[k];
@@ -446,21 +475,8 @@ private:
                     c.towards = s->towards;
                 }
             }
-            if (!c.cut) return 1.0;
-            // The plane meets the disc (normal d) in a line at distance delta / sin(angle(n, d)) from
-            // its centre; a disc parallel to the plane is not cut. A ray point behind the plane
-            // (a curved or another surface there) is left uncorrected rather than guessed.
-            double delta = dot(c.towards, ray_.at(t) - c.p), cosN = dot(c.towards, ray_.d);
-            double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
-            if (!(sinN * r > delta) || delta < 0) return 1.0;
-            return discFractionInside(delta / sinN, r);
+            return c.cut ? &c : nullptr;
         }
-
-    private:
-        struct Cell {
-            bool known = false, cut = false;
-            Vec3 p, towards;
-        };
         const Scene& scene_;
         Ray ray_;
         double a_, b_, h_ = 0, reach_ = 0;
@@ -482,15 +498,17 @@ private:
         return sum;
     }
 
-    /// Beam x beam 1D with short beams (photonBeams.h): flux sigma_s p / (2 r sin theta) T_camera.
+    /// Beam x beam 1D with short beams (photonBeams.h): flux sigma_s p / (2 r sin theta) T_camera, over
+    /// the part of the kernel's width on the ray's side of a surface (SurfaceCuts).
     Spectrum gatherBeams(const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
-                         const MediumStack& stack) const {
+                         const MediumStack& stack, SurfaceCuts cuts) const {
         Spectrum sum;
         int region = stack.innermost();
         beams_->query(ray, a, b, [&](const BeamHit& h) {
             const PhotonBeam& beam = *h.beam;
             if (beam.region != region) return;
-            double kernel = 1 / (2 * double(beam.radius));
+            Vec3 beamDir(beam.dir[0], beam.dir[1], beam.dir[2]);
+            double kernel = 1 / (2 * double(beam.radius) * cuts.insideAcross(h.tCamera, beam.radius, cross(ray.d, beamDir) / h.sinTheta));
             Vec3 x(beam.origin[0] + beam.dir[0] * h.sBeam, beam.origin[1] + beam.dir[1] * h.sBeam,
                    beam.origin[2] + beam.dir[2] * h.sBeam);
             Spectrum f = media.properties(x).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
