@@ -393,7 +393,9 @@ TEST(SceneInstancing, NearestSurfaceMatchesTheBoxDistanceForFlatAndInstancedMesh
         EXPECT_NEAR(s->distance, expected, 1e-12);
         EXPECT_NEAR(length(p - s->p), expected, 1e-12);
         EXPECT_NEAR(length(s->towards), 1.0, 1e-12);
-        if (expected > 1e-9) EXPECT_NEAR(length(s->p + s->towards * s->distance - p), 0.0, 1e-9);
+        if (expected > 1e-9) {
+            EXPECT_NEAR(length(s->p + s->towards * s->distance - p), 0.0, 1e-9);
+        }
     }
     EXPECT_GT(found, 300);  // both branches are exercised
     EXPECT_FALSE(Scene(SceneDesc()).nearestSurface(Vec3(0, 0, 0), 10));
