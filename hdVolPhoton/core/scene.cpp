@@ -255,8 +255,7 @@ bool Scene::intersect(const Ray& ray, double tMin, double tMax, SurfaceHit* hit)
     if (desc_.instances.empty()) return false;
     ++work::rays;
     // Embree asserts on rays outside its range (|org| <= FLT_LARGE = 1.844e18 in rtcore_ray.h);
-    // nothing real lies out there.
-    constexpr double FloatSafe = 1e18;
+    // nothing real lies out there (FloatSafe).
     if (!isFinite(ray.o) || !isFinite(ray.d) || std::abs(ray.o.x) > FloatSafe || std::abs(ray.o.y) > FloatSafe ||
         std::abs(ray.o.z) > FloatSafe || !(tMin <= tMax) || !(tMin < FloatSafe))
         return false;
@@ -379,7 +378,10 @@ bool nearestTriangle(RTCPointQueryFunctionArguments* args) {
 }  // namespace
 
 std::optional<Scene::NearestSurface> Scene::nearestSurface(const Vec3& p, double maxDistance) const {
-    if (desc_.instances.empty() || !isFinite(p) || !(maxDistance > 0)) return std::nullopt;
+    // As for rays (intersect): nothing real lies beyond Embree's range.
+    if (desc_.instances.empty() || !isFinite(p) || !(maxDistance > 0) || std::abs(p.x) > FloatSafe ||
+        std::abs(p.y) > FloatSafe || std::abs(p.z) > FloatSafe)
+        return std::nullopt;
     RTCPointQuery query;
     query.x = static_cast<float>(p.x);
     query.y = static_cast<float>(p.y);

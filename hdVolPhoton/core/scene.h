@@ -194,6 +194,9 @@ public:
     static constexpr double MinSpawnCos = 0.02;
 
 private:
+    /// Coordinates beyond this are outside Embree's range (FLT_LARGE = 1.844e18 in rtcore_ray.h):
+    /// queries there find nothing.
+    static constexpr double FloatSafe = 1e18;
     SceneDesc desc_;
     RTCDevice device_ = nullptr;
     RTCScene top_ = nullptr;

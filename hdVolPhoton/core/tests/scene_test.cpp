@@ -399,6 +399,8 @@ TEST(SceneInstancing, NearestSurfaceMatchesTheBoxDistanceForFlatAndInstancedMesh
     }
     EXPECT_GT(found, 300);  // both branches are exercised
     EXPECT_FALSE(Scene(SceneDesc()).nearestSurface(Vec3(0, 0, 0), 10));
+    EXPECT_FALSE(scene.nearestSurface(Vec3(1e30, 0, 0), Infinity));  // beyond float's range: nothing, no assert
+    EXPECT_FALSE(scene.nearestSurface(Vec3(0, std::nan(""), 0), 10));
 }
 
 TEST(SceneMedia, NestedMediaAndCameraInsideAClosedMesh) {
