@@ -146,7 +146,7 @@ void pathTracerThroughput(bool quick) {
     std::vector<float> points;
     for (const Vec3& p : box.points)
         for (int k = 0; k < 3; ++k) points.push_back(static_cast<float>(p[k]));
-    RTCGeometry g = embreeTriangles(device, points.data(), box.points.size(), box.indices);
+    RTCGeometry g = embreeTriangles(device, points, box.indices);
     rtcAttachGeometry(flat, g);
     rtcReleaseGeometry(g);
     rtcCommitScene(flat);

@@ -36,12 +36,12 @@ inline RTCRayHit embreeRayHit(const Vec3& o, const Vec3& d, double tNear, double
     return rh;
 }
 
-/// A committed triangle geometry: `pointCount` float3 vertices at `points`, three `indices` a triangle.
-/// The caller attaches it to a scene and releases it (Scene, tools/bench_core's raw Embree scene).
-inline RTCGeometry embreeTriangles(RTCDevice device, const float* points, size_t pointCount, const std::vector<uint32_t>& indices) {
+/// A committed triangle geometry: float3 vertices (x, y, z after one another), three `indices` a
+/// triangle. The caller attaches it to a scene and releases it (Scene, tools/bench_core's raw scene).
+inline RTCGeometry embreeTriangles(RTCDevice device, const std::vector<float>& points, const std::vector<uint32_t>& indices) {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), pointCount));
-    std::copy(points, points + 3 * pointCount, v);
+    float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), points.size() / 3));
+    std::copy(points.begin(), points.end(), v);
     unsigned* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), indices.size() / 3));
     std::copy(indices.begin(), indices.end(), idx);
     rtcCommitGeometry(g);

@@ -122,9 +122,6 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         }
         return std::all_of(out->begin(), out->end(), [](float f) { return std::isfinite(f); });
     };
-    auto triangles = [&](const MeshDesc& m, const std::vector<float>& points) {
-        return embreeTriangles(device_, points.data(), m.points.size(), m.indices);
-    };
     std::vector<float> points;
     meshScenes_.assign(desc_.meshes.size(), nullptr);
     auto meshScene = [&](int mi) {
@@ -134,7 +131,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             // triangles, and a path inside a closed medium mesh walks out through the "hole".
             rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
             floatPoints(desc_.meshes[mi], nullptr, &points);
-            RTCGeometry g = triangles(desc_.meshes[mi], points);
+            RTCGeometry g = embreeTriangles(device_, points, desc_.meshes[mi].indices);
             rtcAttachGeometry(s, g);
             rtcReleaseGeometry(g);
             rtcCommitScene(s);
@@ -155,7 +152,7 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
         instanceInverse_.push_back(*inv);
         RTCGeometry g;
         if (instanceCount[inst.mesh] == 1 && floatPoints(desc_.meshes[inst.mesh], &inst.transform, &points)) {
-            g = triangles(desc_.meshes[inst.mesh], points);
+            g = embreeTriangles(device_, points, desc_.meshes[inst.mesh].indices);
         } else {
             g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(g, meshScene(inst.mesh));
