@@ -176,11 +176,7 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
                     return !crossesMedia;
                 });
             media += crossesMedia;
-            if (hasHit) {
-                const MeshDesc& m = scene.mesh(hit.mesh);
-                translucent += scene.meshClosed(hit.mesh) && m.material.kind == SurfaceMaterial::Kind::Dielectric &&
-                               m.interiorMedium >= 0 && !cameraStack.contains(hit.mesh);
-            }
+            translucent += hasHit && scene.meshTranslucent(hit.mesh) && !cameraStack.contains(hit.mesh);
         }
     auto percent = [](int n) { return std::to_string((100 * n + PilotW * PilotH / 2) / (PilotW * PilotH)) + "%"; };
     std::string view = "translucent objects cover " + percent(translucent) + " of the view, open media " + percent(media);
@@ -213,8 +209,12 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.integratorReason = choice.reason;
     } else if (!photonMap && scene_->hasMedia()) {
         // The path tracer cannot carry a delta light's light through a refracting surface (shadow
-        // rays stop at dielectrics): say so rather than render translucent objects without it.
-        IntegratorChoice choice = chooseIntegrator(*scene_, settings_);
+        // rays stop at dielectrics): say so rather than render translucent objects without it. The
+        // pilot runs only where the scene has both (not on every restart of every scene).
+        bool deltaLight = false, translucentMesh = false;
+        for (const LightPtr& l : scene_->lights()) deltaLight |= l->isDelta();
+        for (size_t i = 0; i < scene_->desc().meshes.size(); ++i) translucentMesh |= scene_->meshTranslucent(static_cast<int>(i));
+        IntegratorChoice choice = deltaLight && translucentMesh ? chooseIntegrator(*scene_, settings_) : IntegratorChoice{};
         if (choice.photonsOnly)
             warn("pathTracer integrator: " + choice.reason.substr(0, choice.reason.find(';')) +
                  ", and the light of point, spot and sharp distant lights reaches inside them only as photons: it is "

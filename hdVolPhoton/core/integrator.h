@@ -171,7 +171,7 @@ struct RenderStats {
 
 /// What integrator = auto renders a scene with, and why (RenderStats::integratorReason).
 struct IntegratorChoice {
-    RenderSettings::Integrator integrator;
+    RenderSettings::Integrator integrator = RenderSettings::Integrator::PathTracer;
     std::string reason;
     /// Translucent objects in view and a delta light: the path tracer would miss that light inside.
     bool photonsOnly = false;

@@ -141,6 +141,11 @@ public:
     const MeshDesc& mesh(int i) const { return desc_.meshes[i]; }
     /// Whether mesh i is topologically closed (every edge shared by exactly two triangles).
     bool meshClosed(int i) const { return meshClosed_[i] != 0; }
+    /// Whether mesh i is a translucent object: a closed dielectric with a medium inside.
+    bool meshTranslucent(int i) const {
+        const MeshDesc& m = desc_.meshes[i];
+        return meshClosed(i) && m.material.kind == SurfaceMaterial::Kind::Dielectric && m.interiorMedium >= 0;
+    }
     /// Whether no light can be reached by a straight shadow ray from a point inside the meshes of
     /// `stack`: one of them is a closed dielectric (shadow rays stop at it) with no light's extent
     /// overlapping its bounds. Next-event estimation there always returns zero and is skipped.
