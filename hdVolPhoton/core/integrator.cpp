@@ -198,11 +198,14 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     if (!(settings_.radiusAlpha > 0 && settings_.radiusAlpha <= 1)) throw std::invalid_argument("render settings: radiusAlpha must be in (0, 1]");
     if (settings_.stratifiedDims < 0) throw std::invalid_argument("render settings: stratifiedDims must be >= 0");
     if (!(settings_.photonRadiusMfp >= 0)) throw std::invalid_argument("render settings: photonRadiusMfp must be >= 0");
+    if (!(settings_.combinedPhotonShare >= 0 && settings_.combinedPhotonShare <= 1))
+        throw std::invalid_argument("render settings: combinedPhotonShare must be in [0, 1]");
     if (!(settings_.noiseTarget >= 0) || !(settings_.timeLimit >= 0) || settings_.maxSamplesPerPixel < 1)
         throw std::invalid_argument("render settings: noiseTarget and timeLimit must be >= 0, maxSamplesPerPixel >= 1");
     active_.assign(static_cast<size_t>(settings_.width) * settings_.height, 1);
     stats_.activePixels = active_.size();
-    bool photonMap = settings_.integrator == RenderSettings::Integrator::PhotonMap;
+    const bool combined = settings_.integrator == RenderSettings::Integrator::Combined;
+    bool photonMap = settings_.integrator == RenderSettings::Integrator::PhotonMap || combined;
     if (settings_.integrator == RenderSettings::Integrator::Auto) {
         IntegratorChoice choice = chooseIntegrator(*scene_, settings_);
         photonMap = choice.integrator == RenderSettings::Integrator::PhotonMap;
@@ -230,7 +233,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.passesSkipped.push_back("photon-map camera paths: the scene has no media, so the path tracer renders it");
     }
     usesPhotons_ = photonMap;
-    stats_.integratorUsed = photonMap ? "photonMap" : "pathTracer";
+    stats_.integratorUsed = photonMap ? (combined ? "combined" : "photonMap") : "pathTracer";
     integrator_ = photonMap ? makePhotonMapper(*scene_, settings_, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");

@@ -3,8 +3,11 @@
 // Render settings (the Hydra delegate exposes the same names as render-setting descriptors):
 // | name                | type   | default    | units        | meaning                                          |
 // |---------------------|--------|------------|--------------|--------------------------------------------------|
-// | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, or auto: one of |
-// |                     |        |            |              | them per scene by a pilot (chooseIntegrator)      |
+// | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, combined (the   |
+// |                     |        |            |              | path tracer with the photon map's multiple        |
+// |                     |        |            |              | scattering, combinedPhotonShare), or auto: one of |
+// |                     |        |            |              | pathTracer/photonMap per scene by a pilot         |
+// |                     |        |            |              | (chooseIntegrator)                                |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
 // |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
@@ -47,6 +50,12 @@
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
 // |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
+// | combinedPhotonShare | double | 0          | [0, 1]       | combined: the photon map's share w of the light   |
+// |                     |        |            |              | scattered more than once at a camera path's vertex|
+// |                     |        |            |              | in open media (inside translucent objects it is   |
+// |                     |        |            |              | 1); the path goes on for the rest with probability|
+// |                     |        |            |              | 1 - w. 0: the path tracer's in open media (photons|
+// |                     |        |            |              | only for translucent objects)                     |
 // | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
 // |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
 // |                     |        |            |              | photon points; the radius is then the beams' and  |
@@ -103,8 +112,10 @@
 namespace volphoton {
 
 struct RenderSettings {
-    /// Auto: one of the two, chosen per scene by a pilot of camera rays (chooseIntegrator).
-    enum class Integrator { PathTracer, PhotonMap, Auto };
+    /// Auto: pathTracer or photonMap, chosen per scene by a pilot of camera rays (chooseIntegrator).
+    /// Combined: the path tracer's camera paths with the photon map's estimate of multiple scattering
+    /// along their medium segments (PhotonEstimate, integratorBase.h), weighted by combinedPhotonShare.
+    enum class Integrator { PathTracer, PhotonMap, Auto, Combined };
     Integrator integrator = Integrator::PathTracer;
     int width = 640, height = 360;
     int samplesPerPixel = 16;
@@ -125,6 +136,7 @@ struct RenderSettings {
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 8;
     bool photonBeams = false;
+    double combinedPhotonShare = 0.0;
     int stratifiedDims = 516;  // camera + 16 segments of Rng::SegmentDims
     double marchStep = 0;
     bool singleScattering = true;

@@ -189,7 +189,34 @@ protected:
 /// Fresnel reflectance of a smooth dielectric (unpolarised); eta = n_transmitted / n_incident.
 double fresnelDielectric(double cosI, double eta);
 
-std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings);
+/// \class PhotonEstimate
+/// The photon side of integrator = combined (photonMapper.cpp), asked by the path tracer's camera
+/// paths on every segment in a medium: the photon map's estimate of the light that reaches the segment
+/// after one or more scattering events (or a bounce or a refraction) and scatters towards the camera
+/// along it, the photon-map integrator's multiple-scattering gather. The path tracer weights it by
+/// share(stack) and continues its own paths from medium collisions with probability 1 - share: the
+/// two estimates of multiply scattered light are mixed per vertex (pathTracer.cpp).
+class PhotonEstimate {
+public:
+    virtual ~PhotonEstimate() = default;
+    /// The photon map's share of multiply scattered light at medium vertices inside the meshes of
+    /// `stack`: 1 inside a translucent object (Scene::sealedFromLights: next-event estimation finds
+    /// nothing there, and a delta light's light arrives only as photons), settings.combinedPhotonShare
+    /// elsewhere; 0 when this pass has no photons.
+    virtual double share(const MediumStack& stack) const = 0;
+    struct Along {
+        Spectrum multiple;  ///< the gather, per unit camera throughput
+        Spectrum T{1.0};    ///< the segment's transmittance (closed form, else marched)
+    };
+    /// The gather along local.o + t local.d, t in [0, length], in the media `media` (transmittance
+    /// from local.o included), and the transmittance over the whole segment.
+    virtual Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack,
+                        Rng& rng) const = 0;
+};
+
+/// `photons`: integrator = combined's photon estimate (null: the path tracer alone).
+std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings,
+                                           const PhotonEstimate* photons = nullptr);
 std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
                                              std::shared_ptr<PhotonCache> cache = nullptr);
 

@@ -31,7 +31,8 @@ enum class Branch { Undecided, Medium, Surface };
 
 class PathTracer final : public Integrator {
 public:
-    PathTracer(const Scene& scene, const RenderSettings& settings) : Integrator(scene, settings) {
+    PathTracer(const Scene& scene, const RenderSettings& settings, const PhotonEstimate* photons)
+        : Integrator(scene, settings), photons_(photons) {
         for (const LightPtr& l : scene.lights()) {
             std::optional<Vec3> position = l->equiangularCenter();
             pointLight_.push_back(position.has_value());
@@ -54,6 +55,13 @@ public:
         int depth = 0, crossings = 0;
         bool firstSegment = true;
         bool lightHitIsSingle = false;  // a light hit right after the first medium vertex is single scattering
+        // integrator = combined: the photon map's share of multiply scattered light in the current
+        // media (PhotonEstimate). A path `ending` has left a medium vertex whose light scattered more
+        // than once the photons took (probability share): it follows the phase-sampled direction only
+        // to the light it may hit (that vertex's direct light, MIS-weighted against its next-event
+        // estimate as always), through media and index-matched boundaries, and collects nothing else.
+        double photonShare = 0;
+        bool ending = false;
 
         auto add = [&](const Spectrum& L, bool singleCandidate) {
             if (branch == Branch::Undecided) out.surface += L;  // lights/environment seen directly
@@ -78,45 +86,68 @@ public:
                 media = scene_.mediaFor(stack);
                 if (media.size()) {
                     bool emissive = media.isEmissive();
+                    photonShare = photons_ && !ending ? photons_->share(stack) : 0.0;
+                    // Inside a translucent object the photons take everything scattered: no vertex
+                    // there can sample a light, so the segment is the photon map's camera segment
+                    // (gather, then the transmittance as a weight) and no collision is sampled.
+                    const bool photonSegment = photonShare >= 1 && scene_.sealedFromLights(stack);
                     double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
-                    if (hasPointLights_) {
+                    if (hasPointLights_ && !ending && !photonSegment) {
                         support = mediaSupport(media, local, length);
                         rng.event(Rng::Event::Equiangular);
                         Spectrum L = equiangularPointLight(media, local, support, stack, beta, rng);
                         if (branch == Branch::Undecided) out.single += L;
                         else add(L, false);
                     }
-                    if (emissive) {
+                    if (emissive && !ending) {
                         rng.event(Rng::Event::Emission);
                         Spectrum L = beta * ratioTrackedEmission(media, local, length, rng);
                         if (branch == Branch::Undecided) out.emission += L;
                         else add(L, false);
                     }
-                    rng.event(Rng::Event::Flight);
-                    FlightEnd end = sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
-                        Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
-                        for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
-                        double pc = (e.mp.sigma_t() * beta).average(), pn = (sigma_n * beta).average();
-                        double total = pc + pn;
-                        if (!(total > 0)) { absorbed = true; return false; }
-                        if (rng.uniform() * total < pc) {
-                            // A real collision scatters, carrying the albedo as a weight (sigma_s in
-                            // the phase kernel below) instead of ending the path with probability
-                            // sigma_a / sigma_t; Russian roulette ends low-throughput paths later.
-                            if (e.mp.sigma_s.isBlack()) { absorbed = true; return false; }
-                            beta *= total / (e.sigmaMaj * pc);
-                            scatter = e;
-                            scatter.t += mediumFrom;
-                            scattered = true;
-                            return false;
+                    if (photonSegment) {
+                        PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
+                        if (branch == Branch::Undecided) out.multiple += beta * a.multiple;
+                        else add(beta * a.multiple, false);
+                        if (firstSegment && !a.multiple.isBlack()) out.alpha = 1;
+                        beta *= a.T;
+                        absorbed = beta.isBlack();
+                    } else {
+                        const Spectrum betaSegment = beta;
+                        rng.event(Rng::Event::Flight);
+                        FlightEnd end = sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
+                            Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
+                            for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
+                            double pc = (e.mp.sigma_t() * beta).average(), pn = (sigma_n * beta).average();
+                            double total = pc + pn;
+                            if (!(total > 0)) { absorbed = true; return false; }
+                            if (rng.uniform() * total < pc) {
+                                // A real collision scatters, carrying the albedo as a weight (sigma_s in
+                                // the phase kernel below) instead of ending the path with probability
+                                // sigma_a / sigma_t; Russian roulette ends low-throughput paths later.
+                                if (e.mp.sigma_s.isBlack()) { absorbed = true; return false; }
+                                beta *= total / (e.sigmaMaj * pc);
+                                scatter = e;
+                                scatter.t += mediumFrom;
+                                scattered = true;
+                                return false;
+                            }
+                            beta *= sigma_n * (total / (e.sigmaMaj * pn));
+                            return true;
+                        });
+                        absorbed |= end == FlightEnd::Truncated;
+                        if (photonShare > 0) {
+                            // The photons' estimate along the whole segment, whatever the flight did:
+                            // it and the continuation from a collision (below) estimate the same light.
+                            Spectrum L = betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare;
+                            if (branch == Branch::Undecided) out.multiple += L;
+                            else add(L, false);
                         }
-                        beta *= sigma_n * (total / (e.sigmaMaj * pn));
-                        return true;
-                    });
-                    absorbed |= end == FlightEnd::Truncated;
+                    }
                 }
             }
             if (absorbed) break;
+            if (scattered && ending) break;
             if (scattered) {
                 if (firstSegment) out.alpha = 1;
                 if (++depth > settings_.maxDepth) break;
@@ -141,6 +172,16 @@ public:
                             w *= pd / (pd + pe);
                         }
                         add(beta * f * T * ds.ls.Li * (w / lightDensity), firstVertex);
+                    }
+                }
+                // integrator = combined: the photons took `share` of the light scattered here more than
+                // once; the path goes on for the rest with probability 1 - share (unit weight), else
+                // only to the light its next direction may hit.
+                if (photonShare > 0) {
+                    if (photonShare >= 1) ending = true;
+                    else {
+                        rng.event(Rng::Event::Roulette);
+                        ending = rng.uniform() < photonShare;
                     }
                 }
                 // Phase sampling.
@@ -185,6 +226,8 @@ public:
                 double w = specular ? 1.0 : powerHeuristic(prevPdf, emitterDensity(prevVertex, ahead.hit, prevSurface));
                 add(beta * Le * w, lightWasSingle);
             }
+            // An ending path crosses index-matched boundaries only: it looks for its vertex's direct light.
+            if (ending && scene_.mesh(ahead.hit.mesh).material.kind != SurfaceMaterial::Kind::Boundary) break;
             // Surface light goes to `surface` when the surface is the first vertex (branch Undecided
             // or Surface), else to `multiple`.
             SurfaceScatter s;
@@ -323,6 +366,7 @@ private:
         return beta * Tcam * f * Tsh * ls.Li * (w / (pick * ls.pdf * pe));
     }
 
+    const PhotonEstimate* photons_;
     std::vector<bool> pointLight_;
     std::vector<Vec3> pointLightPosition_;
     bool hasPointLights_ = false;
@@ -340,8 +384,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings) {
-    return std::make_unique<PathTracer>(scene, settings);
+std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings, const PhotonEstimate* photons) {
+    return std::make_unique<PathTracer>(scene, settings, photons);
 }
 
 }  // namespace volphoton

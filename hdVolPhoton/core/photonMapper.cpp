@@ -43,10 +43,16 @@ namespace {
 
 constexpr int PhotonBatch = 4096;
 
-class PhotonMapper final : public Integrator {
+class PhotonMapper final : public Integrator, public PhotonEstimate {
 public:
     PhotonMapper(const Scene& scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache)
         : Integrator(scene, settings), cache_(std::move(cache)) {
+        // integrator = combined: the path tracer's camera paths, asking this map along their segments.
+        if (settings.integrator == RenderSettings::Integrator::Combined) {
+            cameraPaths_ = makePathTracer(scene, settings, this);
+            // With no photon share in open media, only photons inside translucent objects are asked for.
+            sealedOnly_ = settings.combinedPhotonShare == 0;
+        }
         // Defaults follow the media, not the scene: a fog layer over kilometres of terrain keeps its
         // own kernel and step (the scene's size when a medium is unbounded). Photons from distant
         // and dome lights aim half at the media (PhotonAim).
@@ -137,7 +143,20 @@ public:
         return radius_ * std::exp(0.5 * (std::lgamma(x + a) - std::lgamma(a) - std::lgamma(x + 1)));
     }
 
+    /// Before the photon passes are decided (Renderer's camera-pass pilot, which sizes the automatic
+    /// photon count) the share is the setting too, so the pilot counts the work of the combined
+    /// integrator's short camera paths, not the path tracer's full ones.
+    double share(const MediumStack& stack) const override {
+        if (!(map_ || beams_ || !passesDecided_)) return 0.0;
+        return scene_.sealedFromLights(stack) ? 1.0 : settings_.combinedPhotonShare;
+    }
+    Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack, Rng& rng) const override {
+        SegmentResult r = integrateSegment(media, local, length, stack, rng, /*photonsOnly=*/true);
+        return {r.multiple, r.T};
+    }
+
     PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
+        if (cameraPaths_) return cameraPaths_->Li(cameraRay, nearClip, farClip, rng);
         PathRadiance out;
         PathRay path{cameraRay, nearClip, farClip, nearClip};
         auto& [ray, tMin, tMax, mediumFrom] = path;
@@ -234,15 +253,19 @@ private:
         }
     };
 
-    SegmentResult integrateSegment(const MediumAggregate& media, const Ray& ray, double length, const MediumStack& stack, Rng& rng) const {
+    /// photonsOnly: the multiple-scattering gather alone (integrator = combined, whose path tracer
+    /// estimates single scattering and emission); the march then runs only for a transmittance without
+    /// closed form.
+    SegmentResult integrateSegment(const MediumAggregate& media, const Ray& ray, double length, const MediumStack& stack, Rng& rng,
+                                   bool photonsOnly = false) const {
         SegmentResult r;
         SegmentTransmittance tr;
         tr.media = &media;
         tr.ray = &ray;
         tr.closedForm = static_cast<bool>(media.opticalDepth(ray, 0.0, 0.0));
-        bool emissive = media.isEmissive();
+        bool emissive = !photonsOnly && media.isEmissive();
         // No light sampling inside a dielectric that no shadow ray can leave (Scene::sealedFromLights).
-        bool single = settings_.singleScattering && !scene_.sealedFromLights(stack);
+        bool single = !photonsOnly && settings_.singleScattering && !scene_.sealedFromLights(stack);
         double weight = 1.0;  // Russian-roulette weight of the march's early termination
         Spectrum tauRun;      // marched optical depth so far
         double supportStart = Infinity, supportEnd = 0;
@@ -671,7 +694,7 @@ private:
             if (media.size()) {
                 // Beams (photonBeams) of multiply scattered light: the flight in pieces of constant
                 // spectral weight, each ending where the flight or the weight changed (photonBeams.h).
-                const bool beams = out->wantBeams && events >= 1;
+                const bool beams = out->wantBeams && events >= 1 && (!sealedOnly_ || scene_.sealedFromLights(stack));
                 double pieceStart = 0, sigmaMaj = 0;  // the majorant where the last piece ended
                 auto addBeam = [&](double t1) {
                     int region = stack.innermost();
@@ -721,7 +744,7 @@ private:
                 double lobeProb = mp.lobes[lobe].sigma_s.average() / total;
                 Spectrum stored = flux * mp.lobes[lobe].sigma_s / lobeProb;
                 if (energy) energy[events >= 1 ? 1 : 0] += (flux * mp.sigma_s).average();
-                if (events >= 1 && !out->wantBeams) {
+                if (events >= 1 && !out->wantBeams && (!sealedOnly_ || scene_.sealedFromLights(stack))) {
                     Photon ph;
                     for (int c = 0; c < 3; ++c) {
                         ph.p[c] = static_cast<float>(ev.p[c]);
@@ -832,6 +855,7 @@ private:
     }
 
     void decidePasses(RenderStats& stats) {
+        passesDecided_ = true;
         stats.passesRun.push_back("camera");
         if (!scene_.hasMedia()) {
             stats.passesSkipped.push_back("single scattering: the scene has no media");
@@ -839,11 +863,17 @@ private:
             settings_.singleScattering = false;
             return;
         }
-        if (settings_.singleScattering) stats.passesRun.push_back("single scattering");
+        if (cameraPaths_) stats.passesRun.push_back("single scattering (path-traced: combined)");
+        else if (settings_.singleScattering) stats.passesRun.push_back("single scattering");
         else stats.passesSkipped.push_back("single scattering: disabled by settings");
         if (scene_.hasEmissiveMedia() && emitters_.empty())
             warn("photonMap integrator: the emissive media lie outside the scene's bounds, so their scattered light is not photon-traced");
         if (!settings_.multipleScattering) { stats.passesSkipped.push_back("multiple scattering (photons): disabled by settings"); return; }
+        if (sealedOnly_ && !scene_.hasSealedMeshes()) {
+            stats.passesSkipped.push_back("multiple scattering (photons): combined with combinedPhotonShare 0 and no translucent "
+                                          "object (the path tracer's paths carry all of it)");
+            return;
+        }
         if (!sourceDist_.size()) { stats.passesSkipped.push_back("multiple scattering (photons): no lights and no emissive media"); return; }
         double maxAlbedo = 0;
         for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
@@ -901,7 +931,7 @@ private:
             return u;
         };
         uint64_t h = hashKeys(settings_.seed, photonsPerPass, bits(radius_), bits(settings_.radiusAlpha),
-                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonBeams, settings_.photonMapBudgetBytes, pilot.size(),
+                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonBeams, sealedOnly_, settings_.photonMapBudgetBytes, pilot.size(),
                               sourceDist_.size(), scene_.lights().size());
         for (const Photon& ph : pilot) {
             uint32_t w[11];
@@ -924,11 +954,13 @@ private:
     Distribution1D extendedDist_;
     std::vector<Emitter> emitters_;
     Distribution1D sourceDist_;  ///< lights, then emitters_, by power
-    bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false;
+    bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false, passesDecided_ = false;
+    bool sealedOnly_ = false;  ///< combined with combinedPhotonShare 0: photons stored in translucent objects only
     std::shared_ptr<const PhotonMap> map_;  ///< this pass's map (traced, or kept in cache_)
     std::shared_ptr<const PhotonBeamMap> beams_;  ///< or its beams (photonBeams)
     std::shared_ptr<PhotonCache> cache_;
     int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
+    std::unique_ptr<Integrator> cameraPaths_;  ///< integrator = combined: the path tracer's (PhotonEstimate)
     work::Count cameraWork_;  ///< the work of a camera pass (Renderer's pilot, setCameraWork)
 };
 

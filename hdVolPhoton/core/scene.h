@@ -154,6 +154,8 @@ public:
             if (sealed_[stack.mesh[i]]) return true;
         return false;
     }
+    /// Whether some mesh is sealed from the lights (sealedFromLights for a stack holding it).
+    bool hasSealedMeshes() const { return std::find(sealed_.begin(), sealed_.end(), 1) != sealed_.end(); }
     /// The SceneDesc's lights, then one mesh light per instance of an emissive lambertian mesh.
     const std::vector<LightPtr>& lights() const { return desc_.lights; }
     /// Index in lights() of instance i's mesh light, or -1 when the instance does not emit.

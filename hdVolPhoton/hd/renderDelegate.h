@@ -20,7 +20,8 @@ class HdVolPhotonRenderParam;
 /// Render settings (descriptors; the same meanings as hdVolPhoton/core/integrator.h):
 /// | key                          | type  | default    | meaning                                      |
 /// |------------------------------|-------|------------|----------------------------------------------|
-/// | volphoton:integrator         | string| pathTracer | pathTracer, photonMap or auto (a token too)  |
+/// | volphoton:integrator         | string| pathTracer | pathTracer, photonMap, combined or auto      |
+/// |                              |       |            | (a token too)                                |
 /// | convergedSamplesPerPixel     | int   | 16         | (HdRenderSettingsTokens) passes of a batch   |
 /// | enableInteractive            | bool  | true       | (HdRenderSettingsTokens) refine until stopped|
 /// | threadLimit                  | int   | 0          | (HdRenderSettingsTokens) 0: all cores        |
@@ -35,6 +36,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
 /// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
 /// | volphoton:photonBeams        | bool  | false      | photonMap: photon beams instead of points    |
+/// | volphoton:combinedPhotonShare| float | 0          | combined: photons' share in open media       |
 /// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
 /// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |

@@ -68,6 +68,7 @@ py::dict settingsToDict(const RenderSettings& s) {
     d["radiusAlpha"] = s.radiusAlpha;
     d["photonRadiusMfp"] = s.photonRadiusMfp;
     d["photonBeams"] = s.photonBeams;
+    d["combinedPhotonShare"] = s.combinedPhotonShare;
     d["stratifiedDims"] = s.stratifiedDims;
     d["marchStep"] = s.marchStep;
     d["singleScattering"] = s.singleScattering;
@@ -187,7 +188,8 @@ void bindRender(py::module_& m) {
     py::enum_<RenderSettings::Integrator>(rs, "Integrator")
         .value("PathTracer", RenderSettings::Integrator::PathTracer)
         .value("PhotonMap", RenderSettings::Integrator::PhotonMap)
-        .value("Auto", RenderSettings::Integrator::Auto);
+        .value("Auto", RenderSettings::Integrator::Auto)
+        .value("Combined", RenderSettings::Integrator::Combined);
     rs.def(py::init<>())
         .def_readwrite("integrator", &RenderSettings::integrator)
         .def_readwrite("width", &RenderSettings::width)
@@ -205,6 +207,7 @@ void bindRender(py::module_& m) {
         .def_readwrite("radius_alpha", &RenderSettings::radiusAlpha)
         .def_readwrite("photon_radius_mfp", &RenderSettings::photonRadiusMfp)
         .def_readwrite("photon_beams", &RenderSettings::photonBeams)
+        .def_readwrite("combined_photon_share", &RenderSettings::combinedPhotonShare)
         .def_readwrite("stratified_dims", &RenderSettings::stratifiedDims)
         .def_readwrite("march_step", &RenderSettings::marchStep)
         .def_readwrite("single_scattering", &RenderSettings::singleScattering)

@@ -200,13 +200,15 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     """volphoton:integrator on a RenderSettings prim selects the integrator whether authored as a
     token or as a string (the delegate's descriptor is a string so usdview's dialog can edit it):
     the two spellings render bit-identically, "pathTracer" as the default does, and "photonMap"
-    differently (the photon map's passes draw other random numbers), "auto" as the path tracer here."""
+    differently (the photon map's passes draw other random numbers), "auto" as the path tracer here,
+    "combined" as the path tracer too (no translucent object, no photon share in open media)."""
     variants = {"default": "", "pathTracerToken": 'token volphoton:integrator = "pathTracer"',
                 "pathTracerString": 'string volphoton:integrator = "pathTracer"',
                 "photonMapToken": 'token volphoton:integrator = "photonMap"',
                 "photonMapString": 'string volphoton:integrator = "photonMap"',
                 "misspelt": 'token volphoton:integrator = "photonmapper"',
-                "auto": 'token volphoton:integrator = "auto"'}
+                "auto": 'token volphoton:integrator = "auto"',
+                "combined": 'token volphoton:integrator = "combined"'}
     images, logs = _render_furnace_variants(tmp_path, hydra_env, variants,
                                             check_base=lambda base: "volphoton:integrator" not in base)
     assert np.array_equal(images["default"], images["pathTracerToken"])
@@ -218,5 +220,6 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     assert np.array_equal(images["default"], images["misspelt"])
     # auto: a furnace has no translucent object in view, so the path tracer renders it.
     assert np.array_equal(images["default"], images["auto"])
-    assert "volphoton:integrator: unusable value 'photonmapper' (one of pathTracer, photonMap, auto)" in logs["misspelt"], \
+    assert np.array_equal(images["default"], images["combined"])
+    assert "volphoton:integrator: unusable value 'photonmapper' (one of pathTracer, photonMap, combined, auto)" in logs["misspelt"], \
         logs["misspelt"]

@@ -1112,6 +1112,7 @@ SETTINGS_SIZE = (16, 16)
 SETTINGS_CAMERA = CAMERA.replace("float verticalAperture = 16", "float verticalAperture = 24")
 PHOTONS = 'int volphoton:photonsPerPass = 4000'
 PHOTON_MAP = ['token volphoton:integrator = "photonMap"', PHOTONS]
+COMBINED = ['token volphoton:integrator = "combined"', PHOTONS]
 
 # Setting -> (value, context, expectation).  The reference is the base scene with the context;
 # expectations: "pixels" (the same seed gives other pixels), "same" (bit-identical), "darker" (the
@@ -1134,6 +1135,7 @@ SETTING_CASES = {
     "singleScattering": ("bool volphoton:singleScattering = 0", PHOTON_MAP, "darker"),
     "multipleScattering": ("bool volphoton:multipleScattering = 0", PHOTON_MAP, "darker"),
     "photonBeams": ("bool volphoton:photonBeams = 1", PHOTON_MAP, "pixels"),
+    "combinedPhotonShare": ("float volphoton:combinedPhotonShare = 0.5", COMBINED, "pixels"),
     "multipleThreshold": ("float volphoton:multipleThreshold = 1000000", PHOTON_MAP, "darker"),
     "transmittanceCutoff": ("float volphoton:transmittanceCutoff = 0.5", [], "pixels"),
     # Adaptive sampling: an unreachable target renders to the cap (32 passes instead of SPP); a cap

@@ -62,8 +62,8 @@ def build(usd_path, width, height, integrator="pathTracer", threads=0, seed=0, c
     s.width, s.height = width, height
     s.threads = threads
     s.seed = seed
-    s.integrator = (core.RenderSettings.Integrator.PhotonMap if integrator == "photonMap"
-                    else core.RenderSettings.Integrator.PathTracer)
+    s.integrator = {"photonMap": core.RenderSettings.Integrator.PhotonMap, "combined": core.RenderSettings.Integrator.Combined,
+                    "auto": core.RenderSettings.Integrator.Auto}.get(integrator, core.RenderSettings.Integrator.PathTracer)
     for k, v in (overrides or {}).items():
         setattr(s, k, v)
     scene = core.Scene(tr.desc)
@@ -189,7 +189,7 @@ def main(argv=None) -> int:
         p.add_argument("--core", default=None, help="path of another volphoton _core module")
         p.add_argument("--out", required=True)
     r = sub.choices["render"]
-    r.add_argument("--integrator", default="pathTracer", choices=["pathTracer", "photonMap"])
+    r.add_argument("--integrator", default="pathTracer", choices=["pathTracer", "photonMap", "combined", "auto"])
     r.add_argument("--budgets", required=True, help="comma-separated seconds")
     r.add_argument("--max-passes", type=int, default=1 << 20)
     r.add_argument("--overrides", default="", help="JSON {RenderSettings attribute: value}")
@@ -199,7 +199,7 @@ def main(argv=None) -> int:
     f.add_argument("--min-passes", type=int, default=64)
     f.add_argument("--max-passes", type=int, default=1 << 20)
     q = sub.choices["passes"]
-    q.add_argument("--integrator", default="pathTracer", choices=["pathTracer", "photonMap"])
+    q.add_argument("--integrator", default="pathTracer", choices=["pathTracer", "photonMap", "combined", "auto"])
     q.add_argument("--passes", type=int, default=16)
     v = sub.add_parser("voxels")
     v.add_argument("--vdb", required=True)

@@ -49,7 +49,7 @@ QUICK = {"size": (80, 60), "budgets": [0.25, 0.5, 1.0, 2.0, 4.0], "ref_seconds":
 FULL = {"size": (160, 120), "budgets": [0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], "ref_seconds": 240.0,
         "peer_ref_seconds": 120.0, "batches": 8, "novol_passes": 48, "novol_size": (640, 480)}
 REF_SEED = 4242  # never the seed of a timed render, so reference noise is independent
-RENDERERS = ["volphoton pathTracer", "volphoton photonMap", "Mitsuba 3 volpath", "Cycles"]
+RENDERERS = ["volphoton pathTracer", "volphoton photonMap", "volphoton combined", "Mitsuba 3 volpath", "Cycles"]
 
 
 class Run:
@@ -254,7 +254,9 @@ def bench_scene(run: Run, scene: S.BenchScene, peers: dict) -> dict:
     jobs = [("volphoton pathTracer", [PY, os.path.join(HERE, "ours.py"), "render", "--usd", usd, "--size", *size,
                                       "--integrator", "pathTracer", "--budgets", budgets] + core_arg),
             ("volphoton photonMap", [PY, os.path.join(HERE, "ours.py"), "render", "--usd", usd, "--size", *size,
-                                     "--integrator", "photonMap", "--budgets", budgets] + core_arg)]
+                                     "--integrator", "photonMap", "--budgets", budgets] + core_arg),
+            ("volphoton combined", [PY, os.path.join(HERE, "ours.py"), "render", "--usd", usd, "--size", *size,
+                                    "--integrator", "combined", "--budgets", budgets] + core_arg)]
     if peers["mitsuba"].get("available"):
         jobs.append(("Mitsuba 3 volpath", [PY, os.path.join(HERE, "peer_mitsuba.py"), "render", "--scene", scene.name,
                                            "--size", *size, "--budgets", budgets, "--voxels", voxels]))
@@ -290,8 +292,8 @@ def equal_time(res: dict, budgets) -> dict:
     """Ratios ours/theirs of the (reference-noise corrected) RMSE at each budget both curves reach."""
     out = {}
     curves = res["curves"]
-    for ours in ("volphoton pathTracer", "volphoton photonMap"):
-        for theirs in ("Mitsuba 3 volpath", "Cycles", "volphoton pathTracer"):
+    for ours in ("volphoton pathTracer", "volphoton photonMap", "volphoton combined"):
+        for theirs in ("Mitsuba 3 volpath", "Cycles", "volphoton pathTracer", "volphoton photonMap"):
             if ours == theirs or ours not in curves or theirs not in curves:
                 continue
             a, b = curves[ours], curves[theirs]
@@ -458,8 +460,8 @@ def markdown(s: dict) -> str:
         ("Blender " + peers["cycles"].get("version", "")) if peers["cycles"].get("available") else "unavailable: " + peers["cycles"].get("why", "")))
     # Equal-time summary
     L.append("### Equal-time RMSE ratios (ours / theirs; < 1: ours is better) at the largest common budget\n")
-    L.append("| scene | PT / Mitsuba | PT / Cycles | PM / Mitsuba | PM / Cycles | PM / PT |")
-    L.append("|---|---|---|---|---|---|")
+    L.append("| scene | PT / Mitsuba | PT / Cycles | PM / Mitsuba | PM / Cycles | PM / PT | C / PT | C / PM |")
+    L.append("|---|---|---|---|---|---|---|---|")
     for r in s["results"]:
         et = r["equal_time"]
 
@@ -478,7 +480,9 @@ def markdown(s: dict) -> str:
                skip("Cycles") or last("volphoton pathTracer / Cycles"),
                skip("Mitsuba 3 volpath") or last("volphoton photonMap / Mitsuba 3 volpath"),
                skip("Cycles") or last("volphoton photonMap / Cycles"),
-               last("volphoton photonMap / volphoton pathTracer")]
+               last("volphoton photonMap / volphoton pathTracer"),
+               last("volphoton combined / volphoton pathTracer"),
+               last("volphoton combined / volphoton photonMap")]
         L.append("| " + " | ".join(row) + " |")
     L.append("")
     skipped = [(r["title"], k, v) for r in s["results"] for k, v in r["skipped"].items()]
@@ -514,7 +518,7 @@ def markdown(s: dict) -> str:
                     float(np.median([x["setup_seconds"] for x in rr])), float(np.median([x["volume_preprocess_seconds"] for x in rr])))
             elif label.startswith("Mitsuba"):
                 note = "JIT/first render %.2f s excluded" % meta.get("jit_warmup_seconds", float("nan"))
-            elif label == "volphoton photonMap":
+            elif label in ("volphoton photonMap", "volphoton combined"):
                 st = meta.get("stats", {})
                 note = "%s photons/pass, skipped: %s" % (meta.get("settings", {}).get("photonsPerPass", "?"),
                                                         "; ".join(st.get("passes_skipped", [])) or "none")
@@ -557,7 +561,7 @@ def plot(results, path, summary):
     cols = min(4, n)
     rows = (n + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.6 * rows), squeeze=False)
-    style = {"volphoton pathTracer": ("C0", "o"), "volphoton photonMap": ("C1", "s"),
+    style = {"volphoton pathTracer": ("C0", "o"), "volphoton photonMap": ("C1", "s"), "volphoton combined": ("C4", "v"),
              "Mitsuba 3 volpath": ("C2", "^"), "Cycles": ("C3", "D")}
     for ax, r in zip(axes.flat, results):
         for label, c in r["curves"].items():

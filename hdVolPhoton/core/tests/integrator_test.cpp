@@ -661,7 +661,8 @@ TEST(IntegratorAovs, BeautyIsTheSumOfTheSplit) {
 
 TEST(IntegratorDeterminism, BitIdenticalReruns) {
     SceneDesc d = mediaOnlyScene();
-    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap,
+                            RenderSettings::Integrator::Combined}) {
         auto scene = std::make_shared<Scene>(d);
         Renderer a(scene, smallSettings(integrator, 3, 42)), b(scene, smallSettings(integrator, 3, 42)), c(scene, smallSettings(integrator, 3, 43));
         a.render();
@@ -794,6 +795,136 @@ TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
     // Past one group of batches (16 x 4096 photons) the photons are thinned as they are traced, in
     // several rounds: still no bias.
     check(150000, 2, 3000);
+}
+
+namespace {
+/// The scenes integrator = combined is checked on: every kind of light the path tracer treats apart
+/// (a distant light: next-event estimation; a sphere light: next-event estimation with MIS; a point
+/// light: equiangular sampling; volume emission: ratio tracking) and surfaces both lit by and lighting the media.
+std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
+    std::vector<std::pair<std::string, SceneDesc>> scenes;
+    SceneDesc fog = mediaOnlyScene();
+    addFloor(fog);
+    fog.camera = lookAt(Vec3(0.2, 1.5, 4.0), Vec3(0, -0.5, 0), 0.5);
+    fog.lights[1] = makeSphereLight(Vec3(1.5, 0.5, 0.5), 0.3, Spectrum(1.0));
+    scenes.emplace_back("fog over a floor, distant + sphere light", fog);
+    SceneDesc point = mediaOnlyScene();
+    point.lights = {makeSphereLight(Vec3(0.4, 0.2, 0.3), 0.0, Spectrum(3.0))};
+    scenes.emplace_back("fog around a point light", point);
+    SceneDesc glow;
+    auto emit = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.6), Spectrum(0.8, 0.4, 0.1), makeHenyeyGreensteinPhase(0.2));
+    auto near = MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+    glow.media.push_back(std::make_shared<HomogeneousMedium>(emit, Bounds3{Vec3(-1, -0.5, -0.5), Vec3(0, 0.5, 0.5)}));
+    glow.media.push_back(std::make_shared<HomogeneousMedium>(near, Bounds3{Vec3(0, -0.5, -0.5), Vec3(1, 0.5, 0.5)}));
+    glow.unboundedMedia = {0, 1};
+    glow.camera = lookAt(Vec3(0.1, 0.2, 3.0), Vec3(0, 0, 0), 0.45);
+    scenes.emplace_back("emissive cloud beside fog", glow);
+    // A translucent box (a dielectric of n = 1.3 with a medium inside) in thin fog under a dome: inside
+    // it the photons take all multiple scattering whatever the share; outside, the share decides.
+    SceneDesc translucent;
+    auto marble = MediumCoefficients::fromAlbedo(5.0, Spectrum(1.0), Spectrum(0.95, 0.9, 0.8), Spectrum(0.0), makeIsotropicPhase());
+    translucent.media.push_back(std::make_shared<HomogeneousMedium>(marble, Bounds3{Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6)}));
+    MeshDesc box = test::boxMesh("marble", Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6));
+    box.material.kind = SurfaceMaterial::Kind::Dielectric;
+    box.material.ior = 1.3;
+    box.interiorMedium = 0;
+    translucent.meshes.push_back(box);
+    translucent.instances.push_back({0, Affine()});
+    translucent.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(0.3, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase()),
+        Bounds3{Vec3(-2, -2, -2), Vec3(2, 2, 2)}));
+    translucent.unboundedMedia.push_back(1);
+    translucent.lights.push_back(makeDomeLight(Spectrum(1.0)));
+    translucent.camera = lookAt(Vec3(0.3, 0.4, 2.5), Vec3(0, 0, 0), 0.6);
+    scenes.emplace_back("translucent box in fog under a dome", translucent);
+    return scenes;
+}
+}  // namespace
+
+TEST(IntegratorCombined, PhotonShareZeroIsThePathTracerExactly) {
+    // The weights of the two estimates of multiply scattered light at a medium vertex are share and
+    // 1 - share (pathTracer.cpp): at share 0 (the default) in scenes without translucent objects the
+    // photons' weight is 0 everywhere and the path always goes on, so the image is the path tracer's
+    // bit for bit, and no photon is traced (the stats say why).
+    for (auto& [name, d] : combinedScenes()) {
+        auto scene = std::make_shared<Scene>(d);
+        if (scene->hasSealedMeshes()) continue;  // a translucent object takes the photons at any share
+        RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 4, 7), combined = pt;
+        combined.integrator = RenderSettings::Integrator::Combined;
+        ASSERT_EQ(combined.combinedPhotonShare, 0.0);
+        Renderer a(scene, pt), b(scene, combined);
+        a.render();
+        b.render();
+        EXPECT_EQ(a.film().resolveRgb(Film::Beauty), b.film().resolveRgb(Film::Beauty)) << name;
+        EXPECT_EQ(b.stats().integratorUsed, "combined");
+        EXPECT_EQ(b.stats().photonsTraced, 0u) << name;
+        bool said = false;
+        for (const std::string& s : b.stats().passesSkipped) said |= s.find("no translucent object") != std::string::npos;
+        EXPECT_TRUE(said) << name;
+    }
+}
+
+TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
+    // Single scattering and volume emission are the path tracer's own estimators in the combined
+    // integrator: they must agree with the path tracer within the noise alone (4 standard errors over
+    // 8 seeds). Multiple scattering mixes the photon gather (weight share) with the continued path
+    // (probability 1 - share): within the noise plus 3% of it for the photon kernel's bias (initial
+    // radius 0.05 of 2-unit boxes). The check has teeth: 4 sigma below 8% of the multiple part.
+    const Film::Aov aovs[4] = {Film::Single, Film::Multiple, Film::Emission, Film::Beauty};
+    uint64_t photonsTraced = 0;  // by the last render of means()
+    auto means = [&](const SceneDesc& d, RenderSettings s) {
+        auto scene = std::make_shared<Scene>(d);
+        std::vector<double> xs[4];
+        for (int seed = 0; seed < test::RenderSeeds; ++seed) {
+            s.seed = seed;
+            Renderer r(scene, s);
+            r.render();
+            for (int k = 0; k < 4; ++k) xs[k].push_back(aovMean(r.film(), aovs[k]));
+            photonsTraced = r.stats().photonsTraced;
+        }
+        std::array<test::MeanAndError, 4> out;
+        for (int k = 0; k < 4; ++k) out[k] = meanAndError(xs[k]);
+        return out;
+    };
+    auto sigma = [](const test::MeanAndError& a, const test::MeanAndError& b) { return std::hypot(a.stderr_, b.stderr_); };
+    for (auto& [name, d] : combinedScenes()) {
+        const auto ref = means(d, smallSettings(RenderSettings::Integrator::PathTracer, 256, 0));
+        const bool translucent = name.find("translucent") != std::string::npos;
+        for (double share : {0.0, 1.0, 0.5}) {
+            // Share 0 without a translucent object is the path tracer itself (PhotonShareZeroIsThePathTracerExactly).
+            if (share == 0 && !translucent) continue;
+            RenderSettings c = smallSettings(RenderSettings::Integrator::Combined, 32, 0);
+            c.photonsPerPass = 16000;
+            c.combinedPhotonShare = share;
+            const auto got = means(d, c);
+            std::printf("%s, share %.1f: single %.5f/%.5f multiple %.5f +- %.5f / %.5f +- %.5f emission %.5f/%.5f\n", name.c_str(),
+                        share, got[0].mean, ref[0].mean, got[1].mean, got[1].stderr_, ref[1].mean, ref[1].stderr_, got[2].mean,
+                        ref[2].mean);
+            const double bias = 0.03 * ref[1].mean;
+            for (int k = 0; k < 4; ++k)
+                EXPECT_NEAR(got[k].mean, ref[k].mean, 4 * sigma(got[k], ref[k]) + (k % 2 ? bias : 1e-9))
+                    << name << " share " << share << " aov " << aovs[k];
+            EXPECT_LT(4 * sigma(got[1], ref[1]), 0.08 * ref[1].mean) << name << " share " << share;
+            EXPECT_GT(photonsTraced, 0u) << name << " share " << share;
+        }
+    }
+}
+
+TEST(IntegratorCombined, FurnaceEveryPhase) {
+    // The camera inside a lossless medium under a dome of radiance 1: every pixel is 1. The combined
+    // integrator's multiple scattering is all photons (share 1 set) here, as in the photon map's furnace.
+    for (auto& [name, phase] : allPhases()) {
+        auto make = [&, phase = phase]() {
+            Bounds3 box{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
+            return furnaceScene(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(1.5, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), phase), box),
+                                Vec3(0.1, 0.0, 0.2));
+        };
+        RenderSettings s = smallSettings(RenderSettings::Integrator::Combined, 4, 0);
+        s.photonsPerPass = 8000;
+        s.initialRadius = 0.25;
+        s.combinedPhotonShare = 1;
+        expectEveryPixel(renderSeeds(make, s), 1.0, 5, 0.02, "combined furnace " + name);
+    }
 }
 
 TEST(IntegratorAgreement, ScatteringEmissiveMedium) {

@@ -224,20 +224,24 @@ TEST(PhotonMapConsistency, KernelBiasFallsAsPhotonsAccumulate) {
     RenderSettings pt = test::smallSettings(RenderSettings::Integrator::PathTracer, 128, 0);
     pt.width = pt.height = 4;
     auto ref = multiple(pt, 16);
-    for (bool beams : {false, true}) {
-        RenderSettings pm = test::smallSettings(RenderSettings::Integrator::PhotonMap, 1, 0);
+    // Points, beams, and integrator = combined (the path tracer's camera paths with the point gather).
+    for (int variant : {0, 1, 2}) {
+        const bool beams = variant == 1;
+        const char* what = variant == 0 ? "points" : variant == 1 ? "beams" : "combined";
+        RenderSettings pm = test::smallSettings(variant == 2 ? RenderSettings::Integrator::Combined : RenderSettings::Integrator::PhotonMap, 1, 0);
         pm.width = pm.height = 4;
         pm.photonsPerPass = 10000;
         pm.initialRadius = 1.0;
         pm.photonBeams = beams;
+        pm.combinedPhotonShare = 1;  // combined: the photons take all multiple scattering in the open fog
         auto few = multiple(pm, 16);
         pm.samplesPerPixel = 64;
         auto many = multiple(pm, 8);
         double errFew = few.mean - ref.mean, errMany = many.mean - ref.mean;
-        std::printf("multiple: path tracer %.4f +- %.4f, photon %s 1 pass %.4f +- %.4f, 64 passes %.4f +- %.4f\n", ref.mean,
-                    ref.stderr_, beams ? "beams" : "points", few.mean, few.stderr_, many.mean, many.stderr_);
-        EXPECT_GT(std::abs(errFew), 4 * std::hypot(few.stderr_, ref.stderr_)) << "beams " << beams;  // the bias is there
-        EXPECT_LT(std::abs(errMany), 0.7 * std::abs(errFew)) << "beams " << beams;
+        std::printf("multiple: path tracer %.4f +- %.4f, %s 1 pass %.4f +- %.4f, 64 passes %.4f +- %.4f\n", ref.mean,
+                    ref.stderr_, what, few.mean, few.stderr_, many.mean, many.stderr_);
+        EXPECT_GT(std::abs(errFew), 4 * std::hypot(few.stderr_, ref.stderr_)) << what;  // the bias is there
+        EXPECT_LT(std::abs(errMany), 0.7 * std::abs(errFew)) << what;
     }
 }
 

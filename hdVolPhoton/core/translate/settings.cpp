@@ -45,10 +45,11 @@ std::vector<SettingInfo> makeTable() {
     using RS = RenderSettings;
     constexpr double Big = 1e9;
     std::vector<SettingInfo> t;
-    t.push_back({"integrator", SettingType::Choice, 0, 0, {"pathTracer", "photonMap", "auto"}, "--integrator",
+    t.push_back({"integrator", SettingType::Choice, 0, 0, {"pathTracer", "photonMap", "combined", "auto"}, "--integrator",
                  "volphoton:integrator", "Integrator", "",
-                 "pathTracer (unbiased volumetric path tracer), photonMap (single-scattering march + volume photon map) "
-                 "or auto (one of them per scene from a pilot of camera rays; the stats say which and why)",
+                 "pathTracer (unbiased volumetric path tracer), photonMap (single-scattering march + volume photon map), "
+                 "combined (path-traced camera paths with the photon map's multiple scattering) "
+                 "or auto (pathTracer or photonMap per scene from a pilot of camera rays; the stats say which and why)",
                  [](const RS& s) { return AttrValue(integratorName(s.integrator)); },
                  [](RS& s, const AttrValue& v) { parseIntegrator(std::get<std::string>(v), &s.integrator); }});
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
@@ -85,6 +86,11 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(doubleSetting("photonRadiusMfp", 0, Big, "", "Photon radius cap (mean free paths)", "mean free paths",
                               "photonMap: a photon's radius is at most this many mean free paths (0: no cap)",
                               &RS::photonRadiusMfp));
+    t.push_back(doubleSetting("combinedPhotonShare", 0, 1, "", "Combined: photon share", "",
+                              "combined: the photon map's share of the light scattered more than once at a camera "
+                              "path's vertex in open media (1 inside translucent objects); the path goes on for the "
+                              "rest with probability 1 - share (0: the path tracer's in open media)",
+                              &RS::combinedPhotonShare));
     t.push_back(boolSetting("photonBeams", "", "Photon beams",
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points",
                             &RS::photonBeams));
@@ -130,6 +136,7 @@ std::string integratorName(RenderSettings::Integrator i) {
     switch (i) {
     case RenderSettings::Integrator::PhotonMap: return "photonMap";
     case RenderSettings::Integrator::Auto: return "auto";
+    case RenderSettings::Integrator::Combined: return "combined";
     default: return "pathTracer";
     }
 }
@@ -138,6 +145,7 @@ bool parseIntegrator(const std::string& text, RenderSettings::Integrator* out) {
     if (text == "pathTracer" || text == "pathtracer") return *out = RenderSettings::Integrator::PathTracer, true;
     if (text == "photonMap" || text == "photonmap") return *out = RenderSettings::Integrator::PhotonMap, true;
     if (text == "auto") return *out = RenderSettings::Integrator::Auto, true;
+    if (text == "combined") return *out = RenderSettings::Integrator::Combined, true;
     return false;
 }
 

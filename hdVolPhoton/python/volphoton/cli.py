@@ -287,7 +287,9 @@ def _integrator(text: str) -> str:
         return "photonMap"
     if t == "auto":
         return "auto"
-    raise argparse.ArgumentTypeError("unknown integrator %r (pathtracer, photonmap or auto)" % text)
+    if t == "combined":
+        return "combined"
+    raise argparse.ArgumentTypeError("unknown integrator %r (pathtracer, photonmap, combined or auto)" % text)
 
 
 def _core_settings_table(core=None):
@@ -527,10 +529,10 @@ def cmd_render(args) -> int:
 
 
 def _photon_cache(core, usdscene, stage, settings, frames, reporter, quiet):
-    """One PhotonCache for the whole frame range when photons can be reused: the photon map integrator (or auto),
+    """One PhotonCache for the whole frame range when photons can be reused: the photon map integrator (combined, or auto),
     several frames, and nothing but cameras animated (usdscene.first_time_varying_content). Reused
     passes are bit-identical to traced ones, so every frame is the image it would be on its own."""
-    if len(frames) < 2 or settings.to_dict()["integrator"] not in ("photonMap", "auto"):
+    if len(frames) < 2 or settings.to_dict()["integrator"] not in ("photonMap", "combined", "auto"):
         return None
     varying = usdscene.first_time_varying_content(stage)
     if varying:
