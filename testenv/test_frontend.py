@@ -763,10 +763,10 @@ def test_render_settings_prim_and_priority(tmp_path):
     assert st["settings"]["maxDepth"] == 5 and st["settings"]["seed"] == 9
 
 
-@pytest.mark.parametrize("ior,chosen", [("1.3", "photonMap"), ("1", "pathTracer")])
+@pytest.mark.parametrize("ior,chosen", [("1.3", "combined"), ("1", "pathTracer")])
 def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
     """--integrator auto: a cube of dense medium filling the middle of the view, translucent behind an
-    n = 1.3 surface (the photon map) or an open medium (ior 1: the path tracer); the stats and the
+    n = 1.3 surface (the combined integrator) or an open medium (ior 1: the path tracer); the stats and the
     log line say which integrator rendered and why (core chooseIntegrator)."""
     stage, path = stage_from(tmp_path, """
         def Cube "marble" (prepend apiSchemas = ["VolPhotonMediumAPI"]) {

@@ -183,10 +183,11 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     bool deltaLight = false;
     for (const LightPtr& l : scene.lights()) deltaLight |= l->isDelta();
     if (translucent > 0 && deltaLight)
-        return {I::PhotonMap, view + "; a point, spot or sharp distant light reaches inside translucent objects only as photons",
-                true};
-    if (translucent > media)
-        return {I::PhotonMap, view + "; the photon map leads the path tracer on translucent objects"};
+        return {I::Combined, view + "; a point, spot or sharp distant light reaches inside translucent objects only as photons, "
+                "which the combined integrator takes there (the path tracer's paths elsewhere)", true};
+    if (translucent > 0)
+        return {I::Combined, view + "; the combined integrator takes photons inside translucent objects, where they lead the "
+                "path tracer, and the path tracer's paths elsewhere"};
     return {I::PathTracer, view + "; the path tracer leads on open media"};
 }
 
@@ -204,13 +205,17 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         throw std::invalid_argument("render settings: noiseTarget and timeLimit must be >= 0, maxSamplesPerPixel >= 1");
     active_.assign(static_cast<size_t>(settings_.width) * settings_.height, 1);
     stats_.activePixels = active_.size();
-    const bool combined = settings_.integrator == RenderSettings::Integrator::Combined;
-    bool photonMap = settings_.integrator == RenderSettings::Integrator::PhotonMap || combined;
+    // The integrator that renders: the one asked for, or auto's choice (settings_ keeps "auto").
+    RenderSettings resolved = settings_;
     if (settings_.integrator == RenderSettings::Integrator::Auto) {
         IntegratorChoice choice = chooseIntegrator(*scene_, settings_);
-        photonMap = choice.integrator == RenderSettings::Integrator::PhotonMap;
+        resolved.integrator = choice.integrator;
         stats_.integratorReason = choice.reason;
-    } else if (!photonMap && scene_->hasMedia()) {
+    }
+    const bool combined = resolved.integrator == RenderSettings::Integrator::Combined;
+    bool photonMap = resolved.integrator == RenderSettings::Integrator::PhotonMap || combined;
+    if (resolved.integrator == RenderSettings::Integrator::PathTracer && settings_.integrator != RenderSettings::Integrator::Auto &&
+        scene_->hasMedia()) {
         // The path tracer cannot carry a delta light's light through a refracting surface (shadow
         // rays stop at dielectrics): say so rather than render translucent objects without it. The
         // pilot runs only where the scene has both (not on every restart of every scene).
@@ -221,7 +226,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         if (choice.photonsOnly)
             warn("pathTracer integrator: " + choice.reason.substr(0, choice.reason.find(';')) +
                  ", and the light of point, spot and sharp distant lights reaches inside them only as photons: it is "
-                 "missing there (use integrator photonMap or auto, or lights with extent)");
+                 "missing there (use integrator combined, photonMap or auto, or lights with extent)");
     }
     if (photonMap && !scene_->hasMedia()) {
         // Without media the photon map has nothing to add: both of its passes would be skipped and its
@@ -234,7 +239,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     }
     usesPhotons_ = photonMap;
     stats_.integratorUsed = photonMap ? (combined ? "combined" : "photonMap") : "pathTracer";
-    integrator_ = photonMap ? makePhotonMapper(*scene_, settings_, std::move(photonCache)) : makePathTracer(*scene_, settings_);
+    integrator_ = photonMap ? makePhotonMapper(*scene_, resolved, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
 }

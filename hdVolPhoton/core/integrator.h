@@ -6,7 +6,7 @@
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, combined (the   |
 // |                     |        |            |              | path tracer with the photon map's multiple        |
 // |                     |        |            |              | scattering, combinedPhotonShare), or auto: one of |
-// |                     |        |            |              | pathTracer/photonMap per scene by a pilot         |
+// |                     |        |            |              | pathTracer/combined per scene by a pilot          |
 // |                     |        |            |              | (chooseIntegrator)                                |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
@@ -112,7 +112,7 @@
 namespace volphoton {
 
 struct RenderSettings {
-    /// Auto: pathTracer or photonMap, chosen per scene by a pilot of camera rays (chooseIntegrator).
+    /// Auto: pathTracer or combined, chosen per scene by a pilot of camera rays (chooseIntegrator).
     /// Combined: the path tracer's camera paths with the photon map's estimate of multiple scattering
     /// along their medium segments (PhotonEstimate, integratorBase.h), weighted by combinedPhotonShare.
     enum class Integrator { PathTracer, PhotonMap, Auto, Combined };
@@ -176,7 +176,7 @@ struct RenderStats {
     std::string stopReason;
     std::vector<std::string> passesRun;
     std::vector<std::string> passesSkipped;  ///< "name: reason"
-    /// The integrator that renders ("pathTracer" / "photonMap") and, for integrator = auto, why.
+    /// The integrator that renders ("pathTracer" / "photonMap" / "combined") and, for integrator = auto, why.
     std::string integratorUsed, integratorReason;
     bool cancelled = false;
 };
@@ -190,11 +190,12 @@ struct IntegratorChoice {
 };
 /// integrator = auto: a pilot of 32 x 24 camera rays through the image finds what the view is made of:
 /// translucent objects (closed dielectric meshes with a medium inside, which next-event estimation
-/// cannot reach), open media, or neither. The photon map renders views where translucent objects
-/// cover more than open media (it leads the path tracer at equal time on both subsurface
-/// benchmark scenes), and any translucent object under a delta light (point, spot, sharp distant),
-/// whose light reaches the inside through the refracting surface only as photons; the path tracer
-/// renders the rest (it leads on every open-media benchmark scene, tools/bench/README.md).
+/// cannot reach), open media, or neither. The combined integrator renders views with any translucent
+/// object in them: it takes photons inside translucent objects, where the photon map leads the path
+/// tracer at equal time (both subsurface benchmark scenes) and where a delta light's light arrives only
+/// as photons (photonsOnly), and the path tracer's paths elsewhere (on the ball behind a fog bank it
+/// leads both); the path tracer renders the rest (it leads on every open-media benchmark scene,
+/// tools/bench/README.md).
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;

@@ -69,6 +69,12 @@ public:
             else if (singleCandidate) out.single += L;
             else out.multiple += L;
         };
+        // Light gathered along a segment in a medium: on the camera's own segment it goes to
+        // `firstSegmentAov` (single, emission or multiple), later by the branch as add() decides.
+        auto addAlong = [&](Spectrum& firstSegmentAov, const Spectrum& L) {
+            if (branch == Branch::Undecided) firstSegmentAov += L;
+            else add(L, false);
+        };
 
         for (int segment = 0;; ++segment) {
             rng.startSegment(segment);
@@ -95,20 +101,15 @@ public:
                     if (hasPointLights_ && !ending && !photonSegment) {
                         support = mediaSupport(media, local, length);
                         rng.event(Rng::Event::Equiangular);
-                        Spectrum L = equiangularPointLight(media, local, support, stack, beta, rng);
-                        if (branch == Branch::Undecided) out.single += L;
-                        else add(L, false);
+                        addAlong(out.single, equiangularPointLight(media, local, support, stack, beta, rng));
                     }
                     if (emissive && !ending) {
                         rng.event(Rng::Event::Emission);
-                        Spectrum L = beta * ratioTrackedEmission(media, local, length, rng);
-                        if (branch == Branch::Undecided) out.emission += L;
-                        else add(L, false);
+                        addAlong(out.emission, beta * ratioTrackedEmission(media, local, length, rng));
                     }
                     if (photonSegment) {
                         PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
-                        if (branch == Branch::Undecided) out.multiple += beta * a.multiple;
-                        else add(beta * a.multiple, false);
+                        addAlong(out.multiple, beta * a.multiple);
                         if (firstSegment && !a.multiple.isBlack()) out.alpha = 1;
                         beta *= a.T;
                         absorbed = beta.isBlack();
@@ -139,9 +140,7 @@ public:
                         if (photonShare > 0) {
                             // The photons' estimate along the whole segment, whatever the flight did:
                             // it and the continuation from a collision (below) estimate the same light.
-                            Spectrum L = betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare;
-                            if (branch == Branch::Undecided) out.multiple += L;
-                            else add(L, false);
+                            addAlong(out.multiple, betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare);
                         }
                     }
                 }

@@ -661,6 +661,10 @@ private:
         out->push_back(beam);
     }
 
+    /// Whether photons (or beams) in the media of `stack` are stored: everywhere, except for combined
+    /// with no share in open media (sealedOnly_), where only translucent objects ask for them.
+    bool storedIn(const MediumStack& stack) const { return !sealedOnly_ || scene_.sealedFromLights(stack); }
+
     void tracePhoton(Rng& rng, int count, PhotonRecords* out, double energy[2]) const {
         double pick;
         size_t source = sourceDist_.sampleDiscrete(rng.uniform(), &pick);
@@ -694,7 +698,7 @@ private:
             if (media.size()) {
                 // Beams (photonBeams) of multiply scattered light: the flight in pieces of constant
                 // spectral weight, each ending where the flight or the weight changed (photonBeams.h).
-                const bool beams = out->wantBeams && events >= 1 && (!sealedOnly_ || scene_.sealedFromLights(stack));
+                const bool beams = out->wantBeams && events >= 1 && storedIn(stack);
                 double pieceStart = 0, sigmaMaj = 0;  // the majorant where the last piece ended
                 auto addBeam = [&](double t1) {
                     int region = stack.innermost();
@@ -744,7 +748,7 @@ private:
                 double lobeProb = mp.lobes[lobe].sigma_s.average() / total;
                 Spectrum stored = flux * mp.lobes[lobe].sigma_s / lobeProb;
                 if (energy) energy[events >= 1 ? 1 : 0] += (flux * mp.sigma_s).average();
-                if (events >= 1 && !out->wantBeams && (!sealedOnly_ || scene_.sealedFromLights(stack))) {
+                if (events >= 1 && !out->wantBeams && storedIn(stack)) {
                     Photon ph;
                     for (int c = 0; c < 3; ++c) {
                         ph.p[c] = static_cast<float>(ev.p[c]);

@@ -71,15 +71,19 @@ std::optional<translate::AttributeRecord> HdVolPhoton_ReadMeshLightRecord(HdScen
     return HdVolPhoton_ReadLightRecord(sd, id);
 }
 
+namespace {
+/// UsdImagingGLEngine's lighting state (usdrecord's and usdview's camera "headlight", a GL-era preview
+/// light under /_UsdImaging_<renderer>_...) is not part of the scene: the standalone front end does
+/// not see it either, so the two would not render the same picture. It follows the camera, so it is
+/// synced on every camera move: it must not touch the scene (the edit gate would restart the render
+/// as a scene edit and drop the photon maps a camera move keeps).
+bool _IsEngineLight(SdfPath const &id) { return TfStringStartsWith(id.GetString(), "/_UsdImaging_"); }
+}  // namespace
+
 void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdDirtyBits *dirtyBits) {
     SdfPath const &id = GetId();
     *dirtyBits = Clean;
-    // UsdImagingGLEngine's lighting state (usdrecord's and usdview's camera "headlight", a GL-era
-    // preview light under /_UsdImaging_<renderer>_...) is not part of the scene: the standalone
-    // front end does not see it either, so the two would not render the same picture. It follows
-    // the camera, so it is synced on every camera move: it must not touch the scene (the edit gate
-    // would restart the render as a scene edit and drop the photon maps a camera move keeps).
-    if (TfStringStartsWith(id.GetString(), "/_UsdImaging_")) return;
+    if (_IsEngineLight(id)) return;
     auto &registry = static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit();
     if (!sd->GetVisible(id)) {
         registry.SetLight(id, nullptr);
@@ -108,7 +112,7 @@ void HdVolPhotonLight::Sync(HdSceneDelegate *sd, HdRenderParam *renderParam, HdD
 }
 
 void HdVolPhotonLight::Finalize(HdRenderParam *renderParam) {
-    if (TfStringStartsWith(GetId().GetString(), "/_UsdImaging_")) return;  // never in the scene (Sync)
+    if (_IsEngineLight(GetId())) return;  // never in the scene
     static_cast<HdVolPhotonRenderParam *>(renderParam)->AcquireSceneForEdit().Remove(GetId());
 }
 

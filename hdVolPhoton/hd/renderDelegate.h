@@ -65,9 +65,7 @@ class HdVolPhotonRenderParam;
     ((photonRadiusMfp, "volphoton:photonRadiusMfp")) \
     ((marchStep, "volphoton:marchStep")) \
     ((multipleThreshold, "volphoton:multipleThreshold")) \
-    ((transmittanceCutoff, "volphoton:transmittanceCutoff")) \
-    (pathTracer)                            \
-    (photonMap)
+    ((transmittanceCutoff, "volphoton:transmittanceCutoff"))
 
 TF_DECLARE_PUBLIC_TOKENS(HdVolPhotonRenderSettingsTokens, HDVOLPHOTON_RENDER_SETTINGS_TOKENS);
 

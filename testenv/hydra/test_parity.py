@@ -474,10 +474,10 @@ AUTO_CUBE = '''    def Cube "marble" (
 '''
 
 
-@pytest.mark.parametrize("translucent,chosen", [(True, "photonMap"), (False, "pathTracer")])
+@pytest.mark.parametrize("translucent,chosen", [(True, "combined"), (False, "pathTracer")])
 def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_env, translucent, chosen):
     """integrator = auto (core chooseIntegrator): the pilot sees a translucent cube filling the middle
-    of the view (a dielectric with a medium inside) and picks the photon map, or the same cube as an
+    of the view (a dielectric with a medium inside) and picks the combined integrator, or the same cube as an
     open medium and picks the path tracer.  In each door the auto image is bit-identical to the one
     rendered with the chosen integrator named, and the two doors agree."""
     body = AUTO_CUBE % {"ior": "        float volphoton:ior = 1.3\n" if translucent else ""}

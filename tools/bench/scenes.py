@@ -471,9 +471,25 @@ def _subsurface_bunny() -> BenchScene:
     )
 
 
+def _ball_behind_fog() -> BenchScene:
+    ball = _subsurface_ball()
+    return BenchScene(
+        name="ball_behind_fog",
+        title="(10) translucent ball seen through a fog bank (open and translucent media together)",
+        camera=ball.camera,
+        media=ball.media + [BoxMedium("fog", box_to_world((-3.0, -2.0, 1.3), (3.0, 2.0, 2.5)), sigma_t=0.6, albedo=0.9,
+                                      phase=Phase("hg", 0.3))],
+        lights=ball.lights,
+        max_depth=1000,
+        photon_settings=dict(ball.photon_settings),
+        notes="scene 8's ball and lights with a slab of fog between the ball and the camera (sigma_t 0.6, albedo 0.9, "
+              "HG g = 0.3, 1.2 deep): neither integrator alone suits both media (issue 15's combined integrator).",
+    )
+
+
 SCENES: List[BenchScene] = [_homogeneous_cube(), _vdb_cloud(), _dense_cloud(), _fog_spotlight(),
                             _atmosphere_sunset(), _emissive_smoke(), _surfaces_only(), _subsurface_ball(),
-                            _subsurface_bunny()]
+                            _subsurface_bunny(), _ball_behind_fog()]
 BY_NAME: Dict[str, BenchScene] = {s.name: s for s in SCENES}
 # The quick set's default: the seven scenes of issue #6 (about 14 min on 2 cores). The subsurface
 # scenes (8, 9; issue #7) add about 3 min: in the full set by default, in the quick set by --scenes.

@@ -564,12 +564,13 @@ TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_) + 0.02 * a.mean);
 }
 
-TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTracerForOpenMedia) {
+TEST(IntegratorAuto, ThePilotPicksCombinedForTranslucentObjectsAndThePathTracerForOpenMedia) {
     // integrator = auto (chooseIntegrator): a translucent box (dielectric, medium inside) filling the
-    // view under a dome -> photon map; the same box behind a fog box that covers the view -> path
-    // tracer (a tie goes to the unbiased one); a small translucent box alone in the view under a
-    // point light or a sphere light -> photon map (only photons reach inside a point-lit one); fog
-    // around the small box -> path tracer unless the light is a point; no media -> path tracer. The Renderer reports the choice and the reason in its stats.
+    // view under a dome -> combined; the same box behind a fog box that covers the view -> combined
+    // (photons inside the box, the path tracer's paths in the fog); a small translucent box alone in
+    // the view under a point light (only photons reach inside: said) or a sphere light, and in fog ->
+    // combined; open media alone or no media -> path tracer. The Renderer reports the choice and the
+    // reason in its stats.
     auto marble = MediumCoefficients::fromAlbedo(20.0, Spectrum(1.0), Spectrum(0.99), Spectrum(0.0), makeIsotropicPhase());
     auto translucentBox = [&](SceneDesc& d, double half) {
         d.media.push_back(std::make_shared<HomogeneousMedium>(marble, Bounds3{Vec3(-half, -half, -half), Vec3(half, half, half)}));
@@ -589,7 +590,7 @@ TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTra
     filled.lights.push_back(makeDomeLight(Spectrum(1.0)));
     filled.camera = lookAt(Vec3(0, 0, 2.5), Vec3(0, 0, 0), 0.3);
     IntegratorChoice c = choose(filled);
-    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
     EXPECT_NE(c.reason.find("translucent objects cover 100% of the view"), std::string::npos) << c.reason;
 
     SceneDesc fogged = filled;
@@ -598,7 +599,7 @@ TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTra
         Bounds3{Vec3(-5, -5, 1.5), Vec3(5, 5, 2)}));
     fogged.unboundedMedia.push_back(static_cast<int>(fogged.media.size()) - 1);
     c = choose(fogged);
-    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
     EXPECT_NE(c.reason.find("open media 100%"), std::string::npos) << c.reason;
 
     SceneDesc small;
@@ -606,17 +607,19 @@ TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTra
     small.lights.push_back(makeSphereLight(Vec3(0, 2, 0), 0.0, Spectrum(1.0)));
     small.camera = filled.camera;
     c = choose(small);
-    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+    EXPECT_TRUE(c.photonsOnly);
     EXPECT_NE(c.reason.find("only as photons"), std::string::npos) << c.reason;
     small.lights[0] = makeSphereLight(Vec3(0, 2, 0), 0.5, Spectrum(1.0));
-    EXPECT_EQ(choose(small).integrator, I::PhotonMap) << choose(small).reason;
+    EXPECT_EQ(choose(small).integrator, I::Combined) << choose(small).reason;
+    EXPECT_FALSE(choose(small).photonsOnly);
     small.media.push_back(fogged.media.back());
     small.unboundedMedia.push_back(static_cast<int>(small.media.size()) - 1);
     c = choose(small);
-    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
     EXPECT_NE(c.reason.find("translucent objects cover 1% of the view, open media 100%"), std::string::npos) << c.reason;
     small.lights[0] = makeSphereLight(Vec3(0, 2, 0), 0.0, Spectrum(1.0));
-    EXPECT_EQ(choose(small).integrator, I::PhotonMap) << choose(small).reason;
+    EXPECT_EQ(choose(small).integrator, I::Combined) << choose(small).reason;
     // The path tracer, asked for by name there, says what it cannot render (and only there).
     auto warnings = [](const SceneDesc& d, RenderSettings rs) {
         std::vector<std::string> messages;
@@ -638,11 +641,15 @@ TEST(IntegratorAuto, ThePilotPicksThePhotonMapForTranslucentObjectsAndThePathTra
     bare.lights.push_back(makeDomeLight(Spectrum(1.0)));
     bare.camera = filled.camera;
     EXPECT_EQ(choose(bare).integrator, I::PathTracer);
+    SceneDesc open = mediaOnlyScene();
+    c = choose(open);
+    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_NE(c.reason.find("translucent objects cover 0% of the view"), std::string::npos) << c.reason;
 
     Renderer r(std::make_shared<Scene>(filled), s);
-    EXPECT_EQ(r.stats().integratorUsed, "photonMap");
+    EXPECT_EQ(r.stats().integratorUsed, "combined");
     EXPECT_EQ(r.stats().integratorReason, choose(filled).reason);
-    Renderer r2(std::make_shared<Scene>(fogged), s);
+    Renderer r2(std::make_shared<Scene>(open), s);
     EXPECT_EQ(r2.stats().integratorUsed, "pathTracer");
 }
 

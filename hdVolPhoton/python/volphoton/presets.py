@@ -59,6 +59,9 @@ How translucent objects are rendered (single scattering included)
         distant with angle 0) cannot light the inside of a translucent object in the path tracer --
         only the photon map renders that -- and small bright lights are noisy.  Light translucent
         objects with area or dome lights when the two integrators must agree.
+      * combined (and auto, which picks it when a translucent object is in view): inside translucent
+        objects as photonMap (the photons' estimate, delta lights included), everywhere else the path
+        tracer's paths.
     Dense presets at real scale take hundreds to thousands of scattering events per path (a 2 cm
     marble object has an optical size of about 50): the default ``maxDepth`` (a safety cap) does not
     truncate them (a lower one does, darkening the object); lower ``photonsPerPass`` (each photon is
