@@ -520,7 +520,8 @@ def markdown(s: dict) -> str:
                 note = "JIT/first render %.2f s excluded" % meta.get("jit_warmup_seconds", float("nan"))
             elif label in ("volphoton photonMap", "volphoton combined"):
                 st = meta.get("stats", {})
-                note = "%s photons/pass, skipped: %s" % (meta.get("settings", {}).get("photonsPerPass", "?"),
+                # The count used (stats): the settings hold 0 for the automatic one.
+                note = "%s photons/pass, skipped: %s" % (st.get("photons_per_pass", "?"),
                                                         "; ".join(st.get("passes_skipped", [])) or "none")
             if c.get("peak_rss_mb"):
                 note = (note + "; " if note else "") + "peak RSS %.0f MB" % c["peak_rss_mb"]
