@@ -763,12 +763,9 @@ def test_render_settings_prim_and_priority(tmp_path):
     assert st["settings"]["maxDepth"] == 5 and st["settings"]["seed"] == 9
 
 
-@pytest.mark.parametrize("ior,chosen", [("1.3", "combined"), ("1", "pathTracer")])
-def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
-    """--integrator auto: a cube of dense medium filling the middle of the view, translucent behind an
-    n = 1.3 surface (the combined integrator) or an open medium (ior 1: the path tracer); the stats and the
-    log line say which integrator rendered and why (core chooseIntegrator)."""
-    stage, path = stage_from(tmp_path, """
+# A cube of dense medium filling the middle of the view under a sphere light; %s: its ior (1.3: a
+# translucent object behind a refracting surface, 1: an open medium).
+MEDIUM_CUBE = """
         def Cube "marble" (prepend apiSchemas = ["VolPhotonMediumAPI"]) {
             double size = 1.6
             float volphoton:density = 8
@@ -779,7 +776,15 @@ def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
                                  uniform token[] xformOpOrder = ["xformOp:translate"] }
         def Camera "cam" { double3 xformOp:translate = (0, 0, 6)
                            uniform token[] xformOpOrder = ["xformOp:translate"] }
-    """ % ior)
+"""
+
+
+@pytest.mark.parametrize("ior,chosen", [("1.3", "combined"), ("1", "pathTracer")])
+def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
+    """--integrator auto: a cube of dense medium filling the middle of the view, translucent behind an
+    n = 1.3 surface (the combined integrator) or an open medium (ior 1: the path tracer); the stats and the
+    log line say which integrator rendered and why (core chooseIntegrator)."""
+    stage, path = stage_from(tmp_path, MEDIUM_CUBE % ior)
     stats = tmp_path / "s.json"
     r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "1",
                 "--integrator", "auto", "--photons", "2000")
@@ -796,18 +801,7 @@ def test_integrator_combined_renders_through_the_cli(tmp_path):
     """--integrator combined: path-traced camera paths, and inside a translucent object (a dielectric
     with a medium inside, where no shadow ray reaches a light) the photon map's multiple scattering;
     the stats say so, with the photons traced and the open-media share (default 0)."""
-    stage, path = stage_from(tmp_path, """
-        def Cube "marble" (prepend apiSchemas = ["VolPhotonMediumAPI"]) {
-            double size = 1.6
-            float volphoton:density = 8
-            float volphoton:ior = 1.3
-        }
-        def SphereLight "lamp" { float inputs:radius = 0.3
-                                 double3 xformOp:translate = (1.5, 2, 1.5)
-                                 uniform token[] xformOpOrder = ["xformOp:translate"] }
-        def Camera "cam" { double3 xformOp:translate = (0, 0, 6)
-                           uniform token[] xformOpOrder = ["xformOp:translate"] }
-    """)
+    stage, path = stage_from(tmp_path, MEDIUM_CUBE % "1.3")
     stats = tmp_path / "s.json"
     r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "2",
                 "--integrator", "combined", "--photons", "2000")

@@ -89,7 +89,7 @@ std::vector<std::pair<std::string, PhasePtr>> allPhases() {
 }
 }  // namespace
 
-TEST(IntegratorFurnace, HomogeneousEveryPhaseBothIntegrators) {
+TEST(IntegratorFurnace, HomogeneousEveryPhaseEveryIntegrator) {
     for (auto& [name, phase] : allPhases()) {
         auto make = [&, phase = phase]() {
             Bounds3 box{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
@@ -98,21 +98,24 @@ TEST(IntegratorFurnace, HomogeneousEveryPhaseBothIntegrators) {
         };
         expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PathTracer, 16, 0)), 1.0, 5, 1e-9, "path tracer furnace " + name);
     }
-    // The photon integrator with the camera inside the medium (no silhouettes for the kernel to blur).
-    for (auto& [name, phase] : allPhases()) {
-        auto make = [&, phase = phase]() {
-            Bounds3 box{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
-            return furnaceScene(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(1.5, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), phase), box),
-                                Vec3(0.1, 0.0, 0.2));
-        };
-        // Strongly forward-scattering lobes make the beam estimate heavy-tailed (one photon can carry
-        // p(0) / (pi r^2) times its power): a wider beam keeps the per-seed means near-normal. In a
-        // furnace the kernel adds no bias away from the box faces.
-        RenderSettings s = smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0);
-        s.photonsPerPass = 8000;
-        s.initialRadius = 0.25;
-        expectEveryPixel(renderSeeds(make, s), 1.0, 5, 0.02, "photon map furnace " + name);
-    }
+    // The photon integrator with the camera inside the medium (no silhouettes for the kernel to blur),
+    // and the combined integrator with all multiple scattering from the photons (share 1).
+    for (auto integrator : {RenderSettings::Integrator::PhotonMap, RenderSettings::Integrator::Combined})
+        for (auto& [name, phase] : allPhases()) {
+            auto make = [&, phase = phase]() {
+                Bounds3 box{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
+                return furnaceScene(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(1.5, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), phase), box),
+                                    Vec3(0.1, 0.0, 0.2));
+            };
+            // Strongly forward-scattering lobes make the beam estimate heavy-tailed (one photon can carry
+            // p(0) / (pi r^2) times its power): a wider beam keeps the per-seed means near-normal. In a
+            // furnace the kernel adds no bias away from the box faces.
+            RenderSettings s = smallSettings(integrator, 4, 0);
+            s.photonsPerPass = 8000;
+            s.initialRadius = 0.25;
+            s.combinedPhotonShare = 1;
+            expectEveryPixel(renderSeeds(make, s), 1.0, 5, 0.02, std::string(integrator == RenderSettings::Integrator::PhotonMap ? "photon map" : "combined") + " furnace " + name);
+        }
 }
 
 TEST(IntegratorFurnace, ChromaticExponentialMedium) {
@@ -805,6 +808,18 @@ TEST(IntegratorPhotonMap, BudgetThinsPhotonsWithoutBias) {
 }
 
 namespace {
+/// An emissive, scattering cloud next to a non-emissive scattering box, no lights.
+SceneDesc emissiveCloudBesideFog() {
+    SceneDesc d;
+    auto glow = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.6), Spectrum(0.8, 0.4, 0.1), makeHenyeyGreensteinPhase(0.2));
+    auto fog = MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+    d.media.push_back(std::make_shared<HomogeneousMedium>(glow, Bounds3{Vec3(-1, -0.5, -0.5), Vec3(0, 0.5, 0.5)}));
+    d.media.push_back(std::make_shared<HomogeneousMedium>(fog, Bounds3{Vec3(0, -0.5, -0.5), Vec3(1, 0.5, 0.5)}));
+    d.unboundedMedia = {0, 1};
+    d.camera = lookAt(Vec3(0.1, 0.2, 3.0), Vec3(0, 0, 0), 0.45);
+    return d;
+}
+
 /// The scenes integrator = combined is checked on: every kind of light the path tracer treats apart
 /// (a distant light: next-event estimation; a sphere light: next-event estimation with MIS; a point
 /// light: equiangular sampling; volume emission: ratio tracking) and surfaces both lit by and lighting the media.
@@ -818,14 +833,7 @@ std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
     SceneDesc point = mediaOnlyScene();
     point.lights = {makeSphereLight(Vec3(0.4, 0.2, 0.3), 0.0, Spectrum(3.0))};
     scenes.emplace_back("fog around a point light", point);
-    SceneDesc glow;
-    auto emit = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.6), Spectrum(0.8, 0.4, 0.1), makeHenyeyGreensteinPhase(0.2));
-    auto near = MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
-    glow.media.push_back(std::make_shared<HomogeneousMedium>(emit, Bounds3{Vec3(-1, -0.5, -0.5), Vec3(0, 0.5, 0.5)}));
-    glow.media.push_back(std::make_shared<HomogeneousMedium>(near, Bounds3{Vec3(0, -0.5, -0.5), Vec3(1, 0.5, 0.5)}));
-    glow.unboundedMedia = {0, 1};
-    glow.camera = lookAt(Vec3(0.1, 0.2, 3.0), Vec3(0, 0, 0), 0.45);
-    scenes.emplace_back("emissive cloud beside fog", glow);
+    scenes.emplace_back("emissive cloud beside fog", emissiveCloudBesideFog());
     // A translucent box (a dielectric of n = 1.3 with a medium inside) in thin fog under a dome: inside
     // it the photons take all multiple scattering whatever the share; outside, the share decides.
     SceneDesc translucent;
@@ -917,33 +925,10 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
     }
 }
 
-TEST(IntegratorCombined, FurnaceEveryPhase) {
-    // The camera inside a lossless medium under a dome of radiance 1: every pixel is 1. The combined
-    // integrator's multiple scattering is all photons (share 1 set) here, as in the photon map's furnace.
-    for (auto& [name, phase] : allPhases()) {
-        auto make = [&, phase = phase]() {
-            Bounds3 box{Vec3(-1, -1, -1), Vec3(1, 1, 1)};
-            return furnaceScene(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(1.5, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), phase), box),
-                                Vec3(0.1, 0.0, 0.2));
-        };
-        RenderSettings s = smallSettings(RenderSettings::Integrator::Combined, 4, 0);
-        s.photonsPerPass = 8000;
-        s.initialRadius = 0.25;
-        s.combinedPhotonShare = 1;
-        expectEveryPixel(renderSeeds(make, s), 1.0, 5, 0.02, "combined furnace " + name);
-    }
-}
-
 TEST(IntegratorAgreement, ScatteringEmissiveMedium) {
     // An emissive, scattering cloud next to a non-emissive scattering box, no lights: all light is
     // volume emission, directly seen (emission AOV) or scattered (multiple). Both integrators agree.
-    SceneDesc d;
-    auto glow = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.6), Spectrum(0.8, 0.4, 0.1), makeHenyeyGreensteinPhase(0.2));
-    auto fog = MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
-    d.media.push_back(std::make_shared<HomogeneousMedium>(glow, Bounds3{Vec3(-1, -0.5, -0.5), Vec3(0, 0.5, 0.5)}));
-    d.media.push_back(std::make_shared<HomogeneousMedium>(fog, Bounds3{Vec3(0, -0.5, -0.5), Vec3(1, 0.5, 0.5)}));
-    d.unboundedMedia = {0, 1};
-    d.camera = lookAt(Vec3(0.1, 0.2, 3.0), Vec3(0, 0, 0), 0.45);
+    SceneDesc d = emissiveCloudBesideFog();
     RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 16, 0);
     RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 8, 0);
     pm.photonsPerPass = 20000;
