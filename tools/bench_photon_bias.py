@@ -24,12 +24,12 @@ def main():
     ap.add_argument("--scenes", required=True, help="comma-separated benchmark scene names")
     ap.add_argument("--seconds", type=float, default=4.0)
     ap.add_argument("--seeds", type=int, default=3)
-    ap.add_argument("--integrator", default="photonMap", choices=("photonMap", "pathTracer", "auto"))
+    ap.add_argument("--integrator", default="photonMap", choices=("photonMap", "pathTracer", "combined", "auto"))
     ap.add_argument("--out", default=os.path.join(REPO, "tools", "out", "bench-emission"),
                     help="a tools/bench/run.py output folder with the scenes' references")
     ap.add_argument("--rows", action="store_true", help="also the relative bias per band of 6 rows")
     a = ap.parse_args()
-    enum = {"photonMap": "PhotonMap", "pathTracer": "PathTracer", "auto": "Auto"}[a.integrator]
+    enum = {"photonMap": "PhotonMap", "pathTracer": "PathTracer", "combined": "Combined", "auto": "Auto"}[a.integrator]
     for name in a.scenes.split(","):
         ref = np.load(os.path.join(a.out, name, "reference_ours.npz"))["mean"]
         rs, tr = load_bench_scene(name, *SIZE)
