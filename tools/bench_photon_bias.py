@@ -28,6 +28,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(REPO, "tools", "out", "bench-emission"),
                     help="a tools/bench/run.py output folder with the scenes' references")
     ap.add_argument("--rows", action="store_true", help="also the relative bias per band of 6 rows")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="a RenderSettings attribute (Python spelling, e.g. photon_radius_mfp=2) over the scene's")
     a = ap.parse_args()
     enum = {"photonMap": "PhotonMap", "pathTracer": "PathTracer", "combined": "Combined", "auto": "Auto"}[a.integrator]
     for name in a.scenes.split(","):
@@ -41,6 +43,9 @@ def main():
             s.noise_target, s.time_limit = 0, a.seconds
             s.samples_per_pixel = s.max_samples_per_pixel = 100000
             s.integrator = getattr(_core.RenderSettings.Integrator, enum)
+            for kv in a.set:
+                k, v = kv.split("=", 1)
+                setattr(s, k, type(getattr(s, k))(float(v)))
             r = _core.Renderer(scene, s)
             r.render()
             img = np.asarray(r.film.beauty, np.float64)

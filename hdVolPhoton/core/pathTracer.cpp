@@ -21,6 +21,11 @@
 // against the free-flight density). For sphere lights the light-sampled half of the direction MIS
 // is split between the two distance strategies and the phase-sampled half stays with free flights,
 // so every (distance, direction) pair's weights still sum to one.
+// integrator = combined runs these camera paths with a PhotonEstimate (photonMapper.cpp): every
+// segment in a medium adds the photon map's gather weighted by share w, and a path scattering there
+// goes on with probability 1 - w (else only to the light its next direction may hit: the vertex's
+// direct light keeps its MIS); inside translucent objects (w = 1) a segment is the photon map's
+// camera segment, its transmittance a weight, no collision sampled.
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
 

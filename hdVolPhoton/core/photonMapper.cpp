@@ -24,6 +24,11 @@
 //  - Volume emission: along camera segments by the march (the `emission` AOV); emissive media also
 //    emit photons (uniform points in the medium's box, weighted by the local emission) so light they
 //    send into scattering media is in the photon map.
+//
+// Integrator 3, combined, is this class too: its photon passes, and the path tracer's camera paths
+// (cameraPaths_, pathTracer.cpp) asking it for the multiple-scattering gather along their segments
+// (PhotonEstimate, integratorBase.h: share() and along()). With combinedPhotonShare 0 it stores
+// photons inside translucent objects only (storedIn) and traces none where there is no such object.
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -151,7 +156,7 @@ public:
         return scene_.sealedFromLights(stack) ? 1.0 : settings_.combinedPhotonShare;
     }
     Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack, Rng& rng) const override {
-        SegmentResult r = integrateSegment(media, local, length, stack, rng, /*photonsOnly=*/true);
+        SegmentResult r = integrateSegment(media, local, length, stack, rng, /*gatherOnly=*/true);
         return {r.multiple, r.T};
     }
 
@@ -253,19 +258,19 @@ private:
         }
     };
 
-    /// photonsOnly: the multiple-scattering gather alone (integrator = combined, whose path tracer
+    /// gatherOnly: the multiple-scattering gather alone (integrator = combined, whose path tracer
     /// estimates single scattering and emission); the march then runs only for a transmittance without
     /// closed form.
     SegmentResult integrateSegment(const MediumAggregate& media, const Ray& ray, double length, const MediumStack& stack, Rng& rng,
-                                   bool photonsOnly = false) const {
+                                   bool gatherOnly = false) const {
         SegmentResult r;
         SegmentTransmittance tr;
         tr.media = &media;
         tr.ray = &ray;
         tr.closedForm = static_cast<bool>(media.opticalDepth(ray, 0.0, 0.0));
-        bool emissive = !photonsOnly && media.isEmissive();
+        bool emissive = !gatherOnly && media.isEmissive();
         // No light sampling inside a dielectric that no shadow ray can leave (Scene::sealedFromLights).
-        bool single = !photonsOnly && settings_.singleScattering && !scene_.sealedFromLights(stack);
+        bool single = !gatherOnly && settings_.singleScattering && !scene_.sealedFromLights(stack);
         double weight = 1.0;  // Russian-roulette weight of the march's early termination
         Spectrum tauRun;      // marched optical depth so far
         double supportStart = Infinity, supportEnd = 0;
