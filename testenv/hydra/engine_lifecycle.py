@@ -2,7 +2,7 @@
 """Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): interactive
 refinement past samplesPerPixel, batch convergence, pause, resume, stop, restart on a camera change,
 when the coarse preview is shown, the integrator setting as usdview's dialog sets it, and photon maps
-kept across camera moves and resizes but not a moved light. Run by
+kept across camera moves and resizes but not a moved light (photonMap, then combined). Run by
 test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
 PXR_PLUGINPATH_NAME:
 
@@ -147,28 +147,37 @@ def main(scene, camera_path, light_path):
         headlight.position = Gf.Vec4f(p[0], p[1], p[2], 1.0)
         engine.SetLightingState([headlight], Glf.SimpleMaterial(), Gf.Vec4f(0.1, 0.1, 0.1, 1.0))
 
-    move_camera(0.0)
-    s = converged_stats()
-    check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "photons traced first: %s" % s)
-    move_camera(-2.0)
-    s = converged_stats()
-    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3 and s["photonsReused"] > 0,
-          "a camera move reuses every photon pass: %s" % s)
-    size = (48, 27)
-    engine.SetRenderBufferSize(Gf.Vec2i(*size))
-    engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), size[0], size[1])))
-    s = converged_stats()
-    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3, "a resize reuses every photon pass: %s" % s)
-    light = UsdGeom.Xformable(stage.GetPrimAtPath(light_path))
-    light.GetOrderedXformOps()[0].Set(Gf.Vec3d(0.3, 3.9, 0.5))
-    s = converged_stats()
-    check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "a moved light traces photons: %s" % s)
-    # Photons feed only the beauty, multiple and surface AOVs: a depth pass traces none.
-    engine.SetRendererAov("depth")
-    move_camera(1.0)
-    s = converged_stats()
-    check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 0 and
-          any("no bound AOV" in x for x in s["passesSkipped"]), "a depth pass traces no photons: %s" % s)
+    for integrator in ("photonMap", "combined"):
+        engine.SetRendererAov("color")
+        engine.SetRenderBufferSize(Gf.Vec2i(*SIZE))
+        engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), SIZE[0], SIZE[1])))
+        move_camera(0.0)
+        if integrator == "combined":
+            # Photons in the open fog too (share 1), so that the combined integrator traces them here.
+            engine.SetRendererSetting("volphoton:integrator", "combined")
+            engine.SetRendererSetting("volphoton:combinedPhotonShare", 1.0)
+        s = converged_stats()
+        check(s["integratorUsed"] == integrator and s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0,
+              "%s: photons traced first: %s" % (integrator, s))
+        move_camera(-2.0)
+        s = converged_stats()
+        check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3 and s["photonsReused"] > 0,
+              "%s: a camera move reuses every photon pass: %s" % (integrator, s))
+        size = (48, 27)
+        engine.SetRenderBufferSize(Gf.Vec2i(*size))
+        engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), size[0], size[1])))
+        s = converged_stats()
+        check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 3, "%s: a resize reuses every photon pass: %s" % (integrator, s))
+        light = UsdGeom.Xformable(stage.GetPrimAtPath(light_path))
+        light.GetOrderedXformOps()[0].Set(Gf.Vec3d(0.3, 3.9, 0.5) if integrator == "photonMap" else Gf.Vec3d(0.2, 3.8, 0.4))
+        s = converged_stats()
+        check(s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0, "%s: a moved light traces photons: %s" % (integrator, s))
+        # Photons feed only the beauty, multiple and surface AOVs: a depth pass traces none.
+        engine.SetRendererAov("depth")
+        move_camera(1.0)
+        s = converged_stats()
+        check(s["photonsTraced"] == 0 and s["photonPassesReused"] == 0 and
+              any("no bound AOV" in x for x in s["passesSkipped"]), "%s: a depth pass traces no photons: %s" % (integrator, s))
     engine.StopRenderer()
     print("OK")
     return 0
