@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Stress suite of the volphoton core and the `volphoton render` front end.
 
-    python tools/stress.py --long        # long form: 200+ generated scenes x 2 integrators, ~300 malformed
+    python tools/stress.py --long        # long form: 200+ generated scenes x 3 integrators, ~300 malformed
                                          # inputs, memory cases (peak RSS per scene); several minutes
     python tools/stress.py               # short form (what testenv/test_stress.py runs), ~40 s
     python tools/stress.py --long --only scenes|malformed|memory   [--json report.json]
     python tools/stress.py --long --core build-withvol/_core.cpython-311-x86_64-linux-gnu.so   # another build
 
-1. Generated scenes (through the Python bindings, tiny images, both integrators) with extreme
+1. Generated scenes (through the Python bindings, tiny images, each of the three integrators (INTEGRATORS)) with extreme
    parameters: sigma_t from 0 to 1e7 per scene unit, HG g = +-0.9999, albedo 0 and 1, scene scales
    1e-4 and 1e5, thin slivers, grazing camera rays, overlapping media (homogeneous + exponential +
    grid), lights inside dense media, media inside dielectrics, a camera inside media, extreme
@@ -97,7 +97,7 @@ SCENE_EXTENTS = [1e-3, 1e-1, 1e1, 1e3, 1e5, 1e7]
 
 
 def generated_cases(long: bool):
-    """Deterministic list of case dicts; every case is rendered with both integrators."""
+    """Deterministic list of case dicts; every case is rendered with each integrator (INTEGRATORS)."""
     cases = []
 
     def add(kind, **p):
@@ -443,6 +443,10 @@ def build_case(core, case, vdb_path):
     return d, (L if furnace else None)
 
 
+# Every generated scene is rendered with each (combined with combinedPhotonShare 1: photons in every medium).
+INTEGRATORS = ("pathTracer", "photonMap", "combined")
+
+
 def run_case(core, case, vdb_path, integrator, passes, size=(8, 6)):
     """Renders one case; returns a result dict (never raises for renderer-level problems)."""
     import numpy as np
@@ -467,8 +471,10 @@ def run_case(core, case, vdb_path, integrator, passes, size=(8, 6)):
         s.photons_per_pass = 2000
         if os.environ.get(BEAMS_ENV) == "1":  # (an older --core has no such setting)
             s.photon_beams = True
-        s.integrator = (core.RenderSettings.Integrator.PhotonMap if integrator == "photonMap"
-                        else core.RenderSettings.Integrator.PathTracer)
+        s.integrator = {"photonMap": core.RenderSettings.Integrator.PhotonMap,
+                        "combined": core.RenderSettings.Integrator.Combined}.get(integrator, core.RenderSettings.Integrator.PathTracer)
+        if integrator == "combined":
+            s.combined_photon_share = 1.0  # the photon gather on every path tracer segment, not only in translucent objects
         r = core.Renderer(scene, s)
         prev, per_pass = None, []
         for k in range(passes):
@@ -535,7 +541,7 @@ def worker_main(args) -> int:
     core = import_core()
     cases = {c["id"]: c for c in generated_cases(True)}
     for cid in [int(x) for x in args.cases.split(",") if x]:
-        for integ in ("pathTracer", "photonMap"):
+        for integ in INTEGRATORS:
             print(json.dumps({"event": "start", "id": cid, "integrator": integ}), flush=True)
             r = run_case(core, cases[cid], args.vdb, integ, args.passes)
             print(json.dumps({"event": "result", **r}), flush=True)
@@ -595,7 +601,7 @@ def run_generated(ids, vdb, passes, per_case_timeout, per_process, log):
                         failures.append({"what": "scene %d (%s) %s" % (ev["id"], ev["case"]["kind"], ev["integrator"]),
                                          "case": ev["case"], "failures": ev["failures"],
                                          "reproduce": "python tools/stress.py --case %d" % ev["id"]})
-                    if ev["integrator"] == "photonMap":
+                    if ev["integrator"] == INTEGRATORS[-1]:
                         done_ids.add(ev["id"])
                     current = None
             _, status, ru = os.wait4(proc.pid, 0)
@@ -1142,7 +1148,7 @@ def main(argv=None) -> int:
     core.write_procedural_cloud_vdb(vdb, 32, 1.0 / 32, 1)
     if args.case is not None:
         case = {c["id"]: c for c in generated_cases(True)}[args.case]
-        for integ in ("pathTracer", "photonMap"):
+        for integ in INTEGRATORS:
             print(json.dumps(run_case(core, case, vdb, integ, passes), indent=1))
         return 0
 
@@ -1150,7 +1156,7 @@ def main(argv=None) -> int:
     report = {"form": "long" if args.long else "short", "failures": [], "core": getattr(core, "__file__", "?")}
     if args.only in (None, "scenes"):
         cases = generated_cases(args.long)
-        log("generated scenes: %d cases x 2 integrators (%s)" % (len(cases), "one process each" if args.long else "batched"))
+        log("generated scenes: %d cases x %d integrators (%s)" % (len(cases), len(INTEGRATORS), "one process each" if args.long else "batched"))
         ids = [c["id"] for c in cases]
         if args.long:
             res, fails, rss = run_generated_isolated(ids, vdb, passes, timeout, log)
