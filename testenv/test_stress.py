@@ -46,7 +46,7 @@ def test_generated_extreme_scenes(tmp_path):
                                              per_process=len(cases), log=print)
     failures = _split_known(failures)
     assert not failures, "stress failures:\n" + _describe(failures)
-    assert len(results) == 2 * len(cases)
+    assert len(results) == len(stress.INTEGRATORS) * len(cases)
     kinds = {r["case"]["kind"] for r in results}
     assert {"box", "sliver", "grazing", "overlap", "light_inside", "dielectric", "grid", "exponential",
             "camera_inside"} <= kinds
