@@ -180,9 +180,7 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
         }
     auto percent = [](int n) { return std::to_string((100 * n + PilotW * PilotH / 2) / (PilotW * PilotH)) + "%"; };
     std::string view = "translucent objects cover " + percent(translucent) + " of the view, open media " + percent(media);
-    bool deltaLight = false;
-    for (const LightPtr& l : scene.lights()) deltaLight |= l->isDelta();
-    if (translucent > 0 && deltaLight)
+    if (translucent > 0 && scene.hasDeltaLight())
         return {I::Combined, view + "; a point, spot or sharp distant light reaches inside translucent objects only as photons, "
                 "which the combined integrator takes there (the path tracer's paths elsewhere)", true};
     if (translucent > 0)
@@ -219,10 +217,9 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         // The path tracer cannot carry a delta light's light through a refracting surface (shadow
         // rays stop at dielectrics): say so rather than render translucent objects without it. The
         // pilot runs only where the scene has both (not on every restart of every scene).
-        bool deltaLight = false, translucentMesh = false;
-        for (const LightPtr& l : scene_->lights()) deltaLight |= l->isDelta();
+        bool translucentMesh = false;
         for (size_t i = 0; i < scene_->desc().meshes.size(); ++i) translucentMesh |= scene_->meshTranslucent(static_cast<int>(i));
-        IntegratorChoice choice = deltaLight && translucentMesh ? chooseIntegrator(*scene_, settings_) : IntegratorChoice{};
+        IntegratorChoice choice = scene_->hasDeltaLight() && translucentMesh ? chooseIntegrator(*scene_, settings_) : IntegratorChoice{};
         if (choice.photonsOnly)
             warn("pathTracer integrator: " + choice.reason.substr(0, choice.reason.find(';')) +
                  ", and the light of point, spot and sharp distant lights reaches inside them only as photons: it is "

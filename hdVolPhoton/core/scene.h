@@ -154,6 +154,10 @@ public:
             if (sealed_[stack.mesh[i]]) return true;
         return false;
     }
+    /// Whether some light is a delta light (point, spot of radius 0, sharp distant light).
+    bool hasDeltaLight() const {
+        return std::any_of(desc_.lights.begin(), desc_.lights.end(), [](const LightPtr& l) { return l->isDelta(); });
+    }
     /// Whether some mesh is sealed from the lights (sealedFromLights for a stack holding it).
     bool hasSealedMeshes() const { return std::find(sealed_.begin(), sealed_.end(), 1) != sealed_.end(); }
     /// The SceneDesc's lights, then one mesh light per instance of an emissive lambertian mesh.
