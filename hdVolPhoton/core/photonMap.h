@@ -11,17 +11,19 @@
 #include "core/embreeRay.h"
 #include "core/functionRef.h"
 #include "core/math.h"
-#include "core/phase.h"
 
 namespace volphoton {
 
-/// A photon stored at a volume scattering event. `power` already includes the scattering coefficient
-/// of the lobe it stands for, so sum(power * p(cos) * kernel) estimates the in-scattered source term.
+/// A photon stored at a volume scattering event: the flux arriving there, without the medium's
+/// scattering coefficient. sum(power * kernel) estimates the radiance arriving at a point (per
+/// direction dir), and a gather applies sigma_s p of the media at its own point (PhotonMapper::gather):
+/// the kernel then blurs the radiance, which is smooth across a jump of density, and not the
+/// scattered source sigma_s L, which jumps with it (a camera ray in a thin medium beside a dense one
+/// gathered the dense one's source with its own transmittance: up to 2x the furnace's radiance).
 struct Photon {
     float p[3];
     float dir[3];  ///< propagation direction before the event
     float power[3];
-    const PhaseFunction* phase;
     int region;  ///< innermost medium mesh at the photon (-1: outside every mesh)
     /// Kernel radius of this photon. The tracer stores a cap tied to the local mean free path; the map
     /// lowers it to the pass radius. Each disc's kernel integrates to one over its own area, so

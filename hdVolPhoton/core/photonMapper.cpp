@@ -357,15 +357,14 @@ private:
         if (!tr.closedForm && !stop) r.T = exp(-tauRun);
         if (single)
             for (int light : pointLights_) r.single += equiangular(light, media, ray, supportStart, std::min(supportEnd, length), tr, stack, rng);
-        // The beam reaches a radius past the medium's ends: photons just inside an interface project
-        // onto the ray just outside it, and dropping them loses energy wherever the source term is
-        // concentrated at the interface (a dense slab's skin); kept, the kernel only blurs it.
+        // Only the media's support gathers (sigma_s is zero elsewhere); a kernel that reaches past an
+        // interface is renormalised to its part inside (SurfaceCuts: surfaces and media boxes).
         if (map_) {
-            double beam = map_->radius(), a = std::max(0.0, supportStart - beam), b = std::min(length, supportEnd + beam);
-            r.multiple = gather(ray, a, b, tr, stack, SurfaceCuts(scene_, ray, a, b, beam));
+            double b = std::min(length, supportEnd);
+            r.multiple = gather(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, map_->radius()));
         } else if (beams_) {
             double b = std::min(length, supportEnd);
-            r.multiple = gatherBeams(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, ray, supportStart, b, beams_->radius()));
+            r.multiple = gatherBeams(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, beams_->radius()));
         }
         return r;
     }
@@ -419,11 +418,13 @@ private:
         return tr.at(t) * f * T * ls.Li / (ls.pdf * pdf);
     }
 
-    /// A photon's kernel radius cap: settings.photonRadiusMfp mean free paths at the photon. A disc far
-    /// wider than the mean free path lets camera segments that pass outside an optically thick layer
-    /// gather the photons of its skin with their own transmittance (~1) instead of the photons' (~0):
-    /// an energy gain without bound as the layer gets denser (tools/stress.py, exponential media with
-    /// a = 1e6). The cap keeps the kernel inside the region the photon's light actually reaches.
+    /// A photon's kernel radius cap: settings.photonRadiusMfp mean free paths at the photon. The
+    /// radiance in an optically thick layer changes over a few mean free paths from its skin, and a
+    /// disc far wider blurs it; before photons carried flux only (Photon), such discs also let camera
+    /// segments outside the layer gather its skin's source with their own transmittance (~1) instead of
+    /// the photons' (~0): an energy gain without bound as the layer got denser (tools/stress.py,
+    /// exponential media with a = 1e6). The cap keeps the kernel inside the region the photon's light
+    /// actually reaches.
     /// Only photons outside every closed medium mesh get it: inside one, gathering is already limited
     /// to the mesh's interior (Photon::region), so no camera segment passes outside such a medium
     /// within its kernel, and an explicit wide radius (a laterally uniform slab) keeps its low noise.
@@ -438,19 +439,24 @@ private:
         return static_cast<float>(settings_.photonRadiusMfp / sigmaTMax);
     }
 
-    /// Surfaces that cut the gather discs along a camera segment (the kernel's boundary bias). Photons
-    /// lie on the segment's side of a surface only, so the disc of radius r around a ray point within r
-    /// of one collects photons over the part of its area on that side: the count estimates f x the
-    /// density, f the disc's fraction inside (1/2 at the surface). Each photon's contribution is divided
-    /// by f at its ray point (the renormalisation correction of kernel density estimation at a boundary;
-    /// M. C. Jones 1993, "Simple boundary correction for kernel density estimation"); a beam's 1D kernel
-    /// across the ray likewise by the part of its width inside (insideAcross). Without it a camera
-    /// ray grazing the ground of benchmark scene 5 lost 29% of its blue multiple scattering. The surface
-    /// is taken as its tangent plane at the point nearest to the middle of a cell of the segment (cells
-    /// 2r long); a cell's closest-point query runs when a photon first falls in it.
+    /// Surfaces and media boxes that cut the gather discs along a camera segment (the kernel's boundary
+    /// bias). Photons lie on the segment's side of a surface only, so the disc of radius r around a ray
+    /// point within r of one collects photons over the part of its area on that side: the count
+    /// estimates f x the density, f the disc's fraction inside (1/2 at the surface). Each photon's
+    /// contribution is divided by f at its ray point (the renormalisation correction of kernel density
+    /// estimation at a boundary; M. C. Jones 1993, "Simple boundary correction for kernel density
+    /// estimation"); a beam's 1D kernel across the ray likewise by the part of its width inside
+    /// (insideAcross). Without it a camera ray grazing the ground of benchmark scene 5 lost 29% of its
+    /// blue multiple scattering. The surface is taken as its tangent plane at the point nearest to the
+    /// middle of a cell of the segment (cells 2r long); a cell's closest-point query runs when a photon
+    /// first falls in it. A medium's box (Medium::bounds) cuts the same way: no photon lies outside it,
+    /// and the ray's point is in it (the gather has sigma_s there); where boxes overlap, the box that
+    /// leaves the disc the most counts (the media's union holds at least that much of it).
     class SurfaceCuts {
     public:
-        SurfaceCuts(const Scene& scene, const Ray& ray, double a, double b, double r) : scene_(scene), ray_(ray), a_(a), b_(b) {
+        SurfaceCuts(const Scene& scene, const MediumAggregate& media, const Ray& ray, double a, double b, double r)
+            : scene_(scene), ray_(ray), a_(a), b_(b) {
+            for (int i = 0; i < media.size() && boxes_ < MediumAggregate::MaxMedia; ++i) box_[boxes_++] = media[i]->bounds();
             if (!scene.hasSurfaces() || !(b > a) || !(r > 0)) return;
             // At most MaxCells cells along a segment: a longer one samples planes further apart.
             constexpr int MaxCells = 256;
@@ -461,27 +467,45 @@ private:
         /// The fraction of the disc of radius r around the ray point at t that lies on the ray's side of
         /// the nearest surface (1 where none is within r).
         double inside(double t, double r) {
-            const Cell* c = cell(t);
-            if (!c) return 1.0;
             // The plane meets the disc (normal d) in a line at distance delta / sin(angle(n, d)) from
             // its centre; a disc parallel to the plane is not cut. A ray point behind the plane
             // (a curved or another surface there) is left uncorrected rather than guessed.
-            double delta = dot(c->towards, ray_.at(t) - c->p), cosN = dot(c->towards, ray_.d);
-            double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
-            if (!(sinN * r > delta) || delta < 0) return 1.0;
-            return discFractionInside(delta / sinN, r);
+            auto cut = [&](double delta, double cosN) {
+                double sinN = std::sqrt(std::max(0.0, 1 - cosN * cosN));
+                return sinN * r > delta && delta >= 0 ? discFractionInside(delta / sinN, r) : 1.0;
+            };
+            const Cell* c = cell(t);
+            double f = c ? cut(dot(c->towards, ray_.at(t) - c->p), dot(c->towards, ray_.d)) : 1.0;
+            return std::min(f, boxes(t, [&](double delta, int axis) { return cut(delta, ray_.d[axis]); }));
         }
         /// The same for a beam's 1D kernel: the fraction of the segment [-r, r] along the unit vector u
         /// (across both the ray and the beam) around the ray point at t on the ray's side.
         double insideAcross(double t, double r, const Vec3& u) {
+            auto cut = [&](double delta, double nu) {
+                nu = std::abs(nu);
+                return nu * r > delta && delta >= 0 ? 0.5 * (1 + delta / (nu * r)) : 1.0;
+            };
             const Cell* c = cell(t);
-            if (!c) return 1.0;
-            double delta = dot(c->towards, ray_.at(t) - c->p), nu = std::abs(dot(c->towards, u));
-            if (!(nu * r > delta) || delta < 0) return 1.0;
-            return 0.5 * (1 + delta / (nu * r));
+            double f = c ? cut(dot(c->towards, ray_.at(t) - c->p), dot(c->towards, u)) : 1.0;
+            return std::min(f, boxes(t, [&](double delta, int axis) { return cut(delta, u[axis]); }));
         }
 
     private:
+        /// The largest fraction over the media boxes holding the ray's point at t, each the smallest
+        /// fraction over its six faces (fraction(distance inside the face, axis)); 1 in no box.
+        template <class Fraction>
+        double boxes(double t, Fraction fraction) const {
+            Vec3 q = ray_.at(t);
+            double best = -1;
+            for (int i = 0; i < boxes_; ++i) {
+                const Bounds3& b = box_[i];
+                if (!b.contains(q)) continue;
+                double f = 1.0;
+                for (int k = 0; k < 3; ++k) f = std::min({f, fraction(q[k] - b.lo[k], k), fraction(b.hi[k] - q[k], k)});
+                best = std::max(best, f);
+            }
+            return best < 0 ? 1.0 : best;
+        }
         struct Cell {
             bool known = false, cut = false;
             Vec3 p, towards;
@@ -510,18 +534,25 @@ private:
         double a_, b_, h_ = 0, reach_ = 0;
         int count_ = 0;
         std::vector<Cell> cells_;
+        Bounds3 box_[MediumAggregate::MaxMedia];
+        int boxes_ = 0;
     };
 
-    Spectrum gather(const Ray& ray, double a, double b, const SegmentTransmittance& tr, const MediumStack& stack,
-                    SurfaceCuts cuts) const {
+    /// The beam radiance estimate along a camera segment: sum over photons of their flux x sigma_s p
+    /// of the media at the photon's point on the ray x T x the disc kernel (Photon: the kernel blurs
+    /// the arriving radiance, and the scattering coefficient is the ray's own).
+    Spectrum gather(const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
+                    const MediumStack& stack, SurfaceCuts cuts) const {
         Spectrum sum;
         int region = stack.innermost();
         map_->query(ray, a, b, [&](const Photon& ph, double t, double) {
             if (ph.region != region) return;
-            double invArea = 1 / (Pi * double(ph.radius) * ph.radius * cuts.inside(t, ph.radius));
             double cosTheta = -(ph.dir[0] * ray.d.x + ph.dir[1] * ray.d.y + ph.dir[2] * ray.d.z);
-            double p = ph.phase->eval(std::clamp(cosTheta, -1.0, 1.0));
-            sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * tr.at(t) * (p * invArea);
+            Vec3 x = ray.at(t);
+            Spectrum f = media.properties(x).scatterKernel(std::clamp(cosTheta, -1.0, 1.0));
+            if (f.isBlack()) return;
+            double invArea = 1 / (Pi * double(ph.radius) * ph.radius * cuts.inside(t, ph.radius));
+            sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * f * tr.at(t) * invArea;
         });
         return sum;
     }
@@ -537,9 +568,8 @@ private:
             if (beam.region != region) return;
             Vec3 beamDir(beam.dir[0], beam.dir[1], beam.dir[2]);
             double kernel = 1 / (2 * double(beam.radius) * cuts.insideAcross(h.tCamera, beam.radius, cross(ray.d, beamDir) / h.sinTheta));
-            Vec3 x(beam.origin[0] + beam.dir[0] * h.sBeam, beam.origin[1] + beam.dir[1] * h.sBeam,
-                   beam.origin[2] + beam.dir[2] * h.sBeam);
-            Spectrum f = media.properties(x).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
+            // sigma_s p at the ray's point, as for photons (gather).
+            Spectrum f = media.properties(ray.at(h.tCamera)).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
             if (f.isBlack()) return;
             sum += Spectrum(beam.power[0], beam.power[1], beam.power[2]) * f * tr.at(h.tCamera) * (kernel / h.sinTheta);
         });
@@ -740,30 +770,22 @@ private:
             if (absorbed) return;
             if (scattered) {
                 const MediumProperties& mp = ev.mp;
-                // Pick the lobe this event stands for in proportion to its average sigma_s.
-                double total = 0;
-                for (int l = 0; l < mp.lobeCount; ++l) total += mp.lobes[l].sigma_s.average();
-                if (!(total > 0)) return;
-                double x = rng.uniform() * total;
-                int lobe = mp.lobeCount - 1;
-                for (int l = 0; l < mp.lobeCount; ++l) {
-                    x -= mp.lobes[l].sigma_s.average();
-                    if (x < 0) { lobe = l; break; }
-                }
-                double lobeProb = mp.lobes[lobe].sigma_s.average() / total;
-                Spectrum stored = flux * mp.lobes[lobe].sigma_s / lobeProb;
                 if (energy) energy[events >= 1 ? 1 : 0] += (flux * mp.sigma_s).average();
                 if (events >= 1 && !out->wantBeams && storedIn(stack)) {
+                    // The flux arriving here (Photon): the gather applies sigma_s p where it looks.
+                    // Spectral tracking's weight grows as 1 / sigma_s where the medium is thin; a
+                    // weight beyond float's range (sigma_s near 1e-38) is not stored.
                     Photon ph;
+                    bool representable = true;
                     for (int c = 0; c < 3; ++c) {
                         ph.p[c] = static_cast<float>(ev.p[c]);
                         ph.dir[c] = static_cast<float>(ray.d[c]);
-                        ph.power[c] = static_cast<float>(stored[c]);
+                        ph.power[c] = static_cast<float>(flux[c]);
+                        representable &= std::isfinite(ph.power[c]);
                     }
-                    ph.phase = mp.lobes[lobe].phase;
                     ph.region = stack.innermost();
                     ph.radius = ph.region < 0 ? radiusCap(mp.sigma_t().maxValue()) : std::numeric_limits<float>::infinity();
-                    out->photons.push_back(ph);
+                    if (representable) out->photons.push_back(ph);
                 }
                 ++events;
                 if (++depth >= DeepRouletteDepth) {  // albedo 1 loses nothing: end deep photons too
