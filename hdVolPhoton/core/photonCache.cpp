@@ -3,8 +3,6 @@
 #include "core/photonBeams.h"
 #include "core/photonMap.h"
 
-#include <algorithm>
-
 namespace volphoton {
 
 size_t PhotonCache::Pass::size() const { return (map ? map->size() : 0) + (beams ? beams->size() : 0); }
@@ -19,7 +17,6 @@ bool PhotonCache::use(uint64_t key) {
     photonsPerPass_ = 0;
     key_ = key;
     hasKey_ = true;
-    media_.clear();
     return false;
 }
 
@@ -29,15 +26,13 @@ std::shared_ptr<const PhotonCache::Pass> PhotonCache::find(int pass) const {
     return it == passes_.end() ? nullptr : it->second;
 }
 
-bool PhotonCache::store(int pass, Pass entry, size_t budgetBytes, const std::vector<MediumPtr>& media) {
+bool PhotonCache::store(int pass, Pass entry, size_t budgetBytes) {
     std::lock_guard<std::mutex> lock(mutex_);
     if ((!entry.map && !entry.beams) || passes_.count(pass)) return false;
     size_t b = entry.bytes();
     if (bytes_ + b > budgetBytes) return false;
     bytes_ += b;
     passes_[pass] = std::make_shared<const Pass>(std::move(entry));
-    for (const MediumPtr& m : media)
-        if (std::find(media_.begin(), media_.end(), m) == media_.end()) media_.push_back(m);
     return true;
 }
 
@@ -64,7 +59,6 @@ size_t PhotonCache::bytes() const {
 void PhotonCache::clear() {
     std::lock_guard<std::mutex> lock(mutex_);
     passes_.clear();
-    media_.clear();
     bytes_ = 0;
     photonsPerPass_ = 0;
     hasKey_ = false;

@@ -6,9 +6,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <vector>
-
-#include "core/medium.h"
 
 namespace volphoton {
 
@@ -30,8 +27,7 @@ class PhotonBeamMap;
 /// the bounds that aim distant light) empties the cache by itself. It is a safety net, not the
 /// contract: the front end still drops the cache when the scene's content changes.
 ///
-/// Photons point at their scene's phase functions, so the cache keeps the media of every scene whose
-/// photons it stored alive (one scene's in a static shot: later frames only read).
+/// Photons and beams hold no pointer into their scene (Photon, PhotonBeam), so cached maps outlive it.
 /// Thread-safe; one render at a time is the intended use.
 class PhotonCache {
 public:
@@ -50,9 +46,8 @@ public:
     bool use(uint64_t key);
     /// The map of pass `pass`, or null when it was not cached under the current key.
     std::shared_ptr<const Pass> find(int pass) const;
-    /// Keeps pass `pass`'s map if the cache then stays within budgetBytes, and with it the `media` of
-    /// the scene its photons were traced in (their phase functions); returns whether it did.
-    bool store(int pass, Pass entry, size_t budgetBytes, const std::vector<MediumPtr>& media);
+    /// Keeps pass `pass`'s map if the cache then stays within budgetBytes; returns whether it did.
+    bool store(int pass, Pass entry, size_t budgetBytes);
     /// Photon count per pass the cached maps were traced with (0 while empty). An automatic count
     /// (RenderSettings::photonsPerPass = 0) follows it, so a resized image keeps its photons.
     int photonsPerPass() const;
@@ -68,7 +63,6 @@ private:
     int photonsPerPass_ = 0;
     size_t bytes_ = 0;
     std::map<int, std::shared_ptr<const Pass>> passes_;
-    std::vector<MediumPtr> media_;
 };
 
 }  // namespace volphoton

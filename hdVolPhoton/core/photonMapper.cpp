@@ -120,7 +120,7 @@ public:
         stats.photonsRadiusCapped += traced.radiusCapped;
         stats.photonsStored += traced.size();
         stats.photonMapBytes = std::max(stats.photonMapBytes, traced.bytes());
-        if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes, scene_.desc().media);
+        if (cache_) cache_->store(pass, std::move(traced), settings_.photonMapBudgetBytes);
         return true;
     }
 

@@ -52,8 +52,11 @@ void HdVolPhotonRenderPass::_Execute(HdRenderPassStateSharedPtr const &state, Tf
         return;
 
     _renderThread->StopRender();
-    // Photons see neither the camera nor the image: a restart for those keeps the photon maps.
-    bool const keepPhotons = _started && version == _lastSceneVersion && settingsVersion == _lastSettingsVersion;
+    // Photons see neither the camera nor the image: a restart for those keeps the photon maps. So does
+    // a settings change: the maps are keyed by the settings photons depend on and by pilot photons
+    // (PhotonCache::use, PhotonMapper's photonKey), so switching photonMap <-> combined reuses them and
+    // a changed photon setting traces them again.
+    bool const keepPhotons = _started && version == _lastSceneVersion;
     _lastSceneVersion = version;
     _lastSettingsVersion = settingsVersion;
     _viewMatrix = view;

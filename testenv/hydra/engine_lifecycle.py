@@ -2,7 +2,8 @@
 """Render-thread lifecycle of the delegate through UsdImagingGL.Engine (no GPU): interactive
 refinement past samplesPerPixel, batch convergence, pause, resume, stop, restart on a camera change,
 when the coarse preview is shown, the integrator setting as usdview's dialog sets it, and photon maps
-kept across camera moves and resizes but not a moved light (photonMap, then combined). Run by
+kept across camera moves, resizes and a switch of integrator but not a moved light or a changed photon
+setting (photonMap, then combined). Run by
 test_hydra_lifecycle.py with OpenUSD's Python (the interpreter of usdrecord) and the delegate on
 PXR_PLUGINPATH_NAME:
 
@@ -153,9 +154,15 @@ def main(scene, camera_path, light_path):
         engine.SetFraming(CameraUtil.Framing(Gf.Rect2i(Gf.Vec2i(0, 0), SIZE[0], SIZE[1])))
         move_camera(0.0)
         if integrator == "combined":
-            # Photons in the open fog too (share 1), so that the combined integrator traces them here.
+            # Photons in the open fog too (share 1): the photon map's photons, so switching keeps its maps
+            # (a settings change keeps them when the photons' key is unchanged, PhotonCache)...
             engine.SetRendererSetting("volphoton:integrator", "combined")
             engine.SetRendererSetting("volphoton:combinedPhotonShare", 1.0)
+            s = converged_stats()
+            check(s["integratorUsed"] == integrator and s["photonsTraced"] == 0 and s["photonPassesReused"] == 3,
+                  "switching photonMap -> combined reuses every photon pass: %s" % s)
+            # ... and a photon setting (the kernel's mean-free-path cap) traces them again.
+            engine.SetRendererSetting("volphoton:photonRadiusMfp", 4.0)
         s = converged_stats()
         check(s["integratorUsed"] == integrator and s["photonsTraced"] == 3 * 2000 and s["photonPassesReused"] == 0,
               "%s: photons traced first: %s" % (integrator, s))
