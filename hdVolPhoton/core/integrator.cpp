@@ -211,7 +211,8 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
         stats_.integratorReason = choice.reason;
     }
     const bool combined = resolved.integrator == RenderSettings::Integrator::Combined;
-    bool photonMap = resolved.integrator == RenderSettings::Integrator::PhotonMap || combined;
+    // The PhotonMapper renders photonMap and combined (its camera paths are the path tracer's then).
+    bool photonMapper = resolved.integrator == RenderSettings::Integrator::PhotonMap || combined;
     if (resolved.integrator == RenderSettings::Integrator::PathTracer && settings_.integrator != RenderSettings::Integrator::Auto &&
         scene_->hasMedia()) {
         // The path tracer cannot carry a delta light's light through a refracting surface (shadow
@@ -225,18 +226,18 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
                  ", and the light of point, spot and sharp distant lights reaches inside them only as photons: it is "
                  "missing there (use integrator combined, photonMap or auto, or lights with extent)");
     }
-    if (photonMap && !scene_->hasMedia()) {
+    if (photonMapper && !scene_->hasMedia()) {
         // Without media the photon map has nothing to add: both of its passes would be skipped and its
         // camera paths (light sampling only, no MIS) are noisier than the path tracer's on the same
         // surfaces (2x the RMSE on benchmark scene 7). Same answer, so the path tracer renders it.
-        photonMap = false;
+        photonMapper = false;
         stats_.passesSkipped.push_back("single scattering: the scene has no media");
         stats_.passesSkipped.push_back("multiple scattering (photons): the scene has no media");
         stats_.passesSkipped.push_back("photon-map camera paths: the scene has no media, so the path tracer renders it");
     }
-    usesPhotons_ = photonMap;
-    stats_.integratorUsed = photonMap ? (combined ? "combined" : "photonMap") : "pathTracer";
-    integrator_ = photonMap ? makePhotonMapper(*scene_, resolved, std::move(photonCache)) : makePathTracer(*scene_, settings_);
+    usesPhotons_ = photonMapper;
+    stats_.integratorUsed = photonMapper ? (combined ? "combined" : "photonMap") : "pathTracer";
+    integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache)) : makePathTracer(*scene_, settings_);
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
 }
