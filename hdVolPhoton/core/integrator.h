@@ -58,8 +58,10 @@
 // |                     |        |            |              | only for translucent objects)                     |
 // | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
 // |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
-// |                     |        |            |              | photon points; the radius is then the beams' and  |
-// |                     |        |            |              | shrinks as r (i+alpha)/(i+1)                      |
+// |                     |        |            |              | photon points, where media are optically thin     |
+// |                     |        |            |              | (points in regions thicker than 100 and in        |
+// |                     |        |            |              | translucent objects); the beams' radius shrinks   |
+// |                     |        |            |              | as r (i+alpha)/(i+1)                              |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
 // |                     |        |            |              | the media's diameter, else of the scene's)        |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |

@@ -179,6 +179,8 @@ public:
     double radius() const { return radius_; }
     /// The box of geometry and bounded media that center() and radius() bound.
     const Bounds3& bounds() const { return bounds_; }
+    /// World bounds of mesh `mesh` over its instances (empty when it has none).
+    const Bounds3& meshBounds(int mesh) const { return meshBounds_[mesh]; }
     /// Bounding sphere of the media (volumes with bounds and media inside meshes); radius 0 when
     /// there are none or one is unbounded. The photon map aims photons and sizes its defaults by it.
     Vec3 mediaCenter() const { return mediaCenter_; }

@@ -35,7 +35,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:stratifiedDims     | int   | 516        | dimensions per camera sample from Sobol'     |
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
 /// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
-/// | volphoton:photonBeams        | bool  | false      | photonMap: photon beams instead of points    |
+/// | volphoton:photonBeams        | bool  | false      | photonMap: beams where media are thin        |
 /// | volphoton:combinedPhotonShare| float | 0          | combined: photons' share in open media       |
 /// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |

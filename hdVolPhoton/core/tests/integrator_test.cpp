@@ -599,6 +599,62 @@ TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
     EXPECT_NEAR(beauty.mean, ptBeauty.mean, 4 * std::hypot(beauty.stderr_, ptBeauty.stderr_) + 0.01 * ptBeauty.mean);
 }
 
+TEST(IntegratorPhotonMap, BeamsWhereMediaAreThinPointsWhereThick) {
+    // photonBeams stores beams per region: in the open fog (optical thickness about 5) beams, inside
+    // an index-matched box of sigma_t 200 (thickness about 280 > 100) points, whose beams would be
+    // heavy-tailed. Alone, the thick box renders the points' image bit for bit; with the fog, the
+    // mixed estimate matches the path tracer's multiple scattering.
+    auto thickBox = [](SceneDesc& d) {
+        auto c = MediumCoefficients::fromAlbedo(200.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
+        d.media.push_back(std::make_shared<HomogeneousMedium>(c));
+        MeshDesc box = test::boxMesh("thick", Vec3(-0.4, -0.4, -0.4), Vec3(0.4, 0.4, 0.4));
+        box.material.kind = SurfaceMaterial::Kind::Boundary;
+        box.interiorMedium = static_cast<int>(d.media.size()) - 1;
+        d.meshes.push_back(box);
+        d.instances.push_back({static_cast<int>(d.meshes.size()) - 1, Affine()});
+    };
+    RenderSettings beams = smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0);
+    beams.photonsPerPass = 4000;
+    beams.photonBeams = true;
+    RenderSettings points = beams;
+    points.photonBeams = false;
+    {
+        SceneDesc d;
+        thickBox(d);
+        d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+        d.camera = lookAt(Vec3(0.2, 0.3, 2.0), Vec3(0, 0, 0), 0.4);
+        auto scene = std::make_shared<Scene>(d);
+        Renderer a(scene, beams), b(scene, points);
+        a.render();
+        b.render();
+        EXPECT_GT(a.stats().photonsStored, 0u);
+        EXPECT_EQ(a.film().resolveRgb(Film::Beauty), b.film().resolveRgb(Film::Beauty)) << "a thick region keeps points";
+        const auto& run = a.stats().passesRun;
+        EXPECT_NE(std::find(run.begin(), run.end(), "photon beams; points in thick (optically thick or translucent)"), run.end());
+    }
+    SceneDesc d = mediaOnlyScene();
+    addFloor(d);
+    thickBox(d);
+    {
+        // The fog takes beams: the image is not the points' one.
+        auto scene = std::make_shared<Scene>(d);
+        Renderer a(scene, beams), b(scene, points);
+        a.render();
+        b.render();
+        EXPECT_NE(a.film().resolveRgb(Film::Multiple), b.film().resolveRgb(Film::Multiple)) << "thin fog takes beams";
+    }
+    RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+    beams.samplesPerPixel = 16;
+    auto ptMultiple = imageMean(d, pt, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    auto mixed = imageMean(d, beams, [](const Film& f) { return aovMean(f, Film::Multiple); });
+    double sigma = std::hypot(ptMultiple.stderr_, mixed.stderr_);
+    std::printf("multiple: path tracer %.5f +- %.5f, beams in the fog and points in the box %.5f +- %.5f\n", ptMultiple.mean,
+                ptMultiple.stderr_, mixed.mean, mixed.stderr_);
+    // 4 standard errors over 16 seeds plus 3% for the kernels' blur (as the beams' agreement test).
+    EXPECT_NEAR(mixed.mean, ptMultiple.mean, 4 * sigma + 0.03 * ptMultiple.mean);
+    EXPECT_LT(4 * sigma, 0.05 * ptMultiple.mean);  // the check has teeth
+}
+
 TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     // A floor under a fog box: the floor sees light scattered by the fog, the fog sees light bounced
     // by the floor. Both integrators must agree on the whole image.
