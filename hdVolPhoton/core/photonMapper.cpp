@@ -963,13 +963,12 @@ private:
         for (const MediumPtr& m : scene_.desc().media) maxAlbedo = std::max(maxAlbedo, m->maxAlbedo());
         if (maxAlbedo == 0) { stats.passesSkipped.push_back("multiple scattering (photons): every medium has albedo 0"); return; }
         // Pilot: the energy reaching second and later scattering events relative to first events.
-        PhotonRecords pilotRecords;  // points: their records key the PhotonCache
+        PhotonRecords pilot;  // points and beams: their records key the PhotonCache
         uint64_t traced = 0;
         constexpr int PilotPhotons = 4096;
         double energy[2] = {0, 0};
         work::Count pilotWork;
-        tracePhotons(-1, PilotPhotons, &pilotRecords, &traced, energy, {}, nullptr, &pilotWork);
-        const std::vector<Photon>& pilot = pilotRecords.photons;
+        tracePhotons(-1, PilotPhotons, &pilot, &traced, energy, {}, nullptr, &pilotWork);
         // No first events but stored ones (light reaching the medium only through a dielectric or a
         // bounce) means everything is the photon map's: an infinite ratio.
         stats.multipleToSingleRatio = energy[0] > 0 ? energy[1] / energy[0] : (energy[1] > 0 ? Infinity : 0.0);
@@ -1018,24 +1017,25 @@ private:
     /// What the photon passes of this render depend on besides the pass index: the photon settings
     /// and the pilot photons (PhotonCache): their records change with any light, medium, surface or
     /// bound they meet.
-    uint64_t photonKey(int photonsPerPass, const std::vector<Photon>& pilot) const {
+    uint64_t photonKey(int photonsPerPass, const PhotonRecords& pilot) const {
         auto bits = [](double x) {
             uint64_t u;
             std::memcpy(&u, &x, sizeof u);
             return u;
         };
         uint64_t h = hashKeys(settings_.seed, photonsPerPass, bits(radius_), bits(settings_.radiusAlpha),
-                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonBeams, sealedOnly_, settings_.photonMapBudgetBytes, pilot.size(),
-                              sourceDist_.size(), scene_.lights().size());
-        for (const Photon& ph : pilot) {
-            uint32_t w[11];
-            std::memcpy(w, ph.p, sizeof ph.p);
-            std::memcpy(w + 3, ph.dir, sizeof ph.dir);
-            std::memcpy(w + 6, ph.power, sizeof ph.power);
-            std::memcpy(w + 9, &ph.radius, sizeof(float));
-            w[10] = static_cast<uint32_t>(ph.region);
+                              bits(settings_.photonRadiusMfp), settings_.maxDepth, settings_.photonBeams, sealedOnly_,
+                              settings_.photonMapBudgetBytes, pilot.photons.size(), pilot.beams.size(), sourceDist_.size(),
+                              scene_.lights().size());
+        // Every field of every record: 4-byte floats and ints with no padding between them.
+        static_assert(sizeof(Photon) == 11 * sizeof(uint32_t) && sizeof(PhotonBeam) == 12 * sizeof(uint32_t));
+        auto hashRecord = [&](const auto& record) {
+            uint32_t w[sizeof(record) / sizeof(uint32_t)];
+            std::memcpy(w, &record, sizeof w);
             for (uint32_t x : w) h = hashKeys(h, x);
-        }
+        };
+        for (const Photon& ph : pilot.photons) hashRecord(ph);
+        for (const PhotonBeam& b : pilot.beams) hashRecord(b);
         return h;
     }
 

@@ -67,16 +67,20 @@ TEST(PhotonCache, ACameraMoveReusesEveryPassAndMatchesAFreshRender) {
 }
 
 TEST(PhotonCache, MovingALightInvalidatesAndRendersAsAFreshRender) {
-    auto cache = std::make_shared<PhotonCache>();
-    RenderSettings s = pmSettings(3);
-    rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
-    SceneDesc lightMoved = fogScene(Vec3(1.5, 0.5, 0.45));  // 5 cm: the pilot photons see it
-    RendererPtr withCache = rendered(lightMoved, s, cache);
-    RendererPtr fresh = rendered(lightMoved, s);
-    EXPECT_EQ(withCache->stats().photonPassesReused, 0);
-    EXPECT_EQ(withCache->stats().photonsTraced, fresh->stats().photonsTraced);
-    EXPECT_EQ(beauty(withCache), beauty(fresh));
-    EXPECT_EQ(cache->passes(), 3u);  // now the moved light's maps
+    // Points, and beams (the fog is thin: its pilot stores beams, whose records key the cache too).
+    for (bool beams : {false, true}) {
+        auto cache = std::make_shared<PhotonCache>();
+        RenderSettings s = pmSettings(3);
+        s.photonBeams = beams;
+        rendered(fogScene(Vec3(1.5, 0.5, 0.5)), s, cache);
+        SceneDesc lightMoved = fogScene(Vec3(1.5, 0.5, 0.45));  // 5 cm: the pilot photons see it
+        RendererPtr withCache = rendered(lightMoved, s, cache);
+        RendererPtr fresh = rendered(lightMoved, s);
+        EXPECT_EQ(withCache->stats().photonPassesReused, 0) << "beams " << beams;
+        EXPECT_EQ(withCache->stats().photonsTraced, fresh->stats().photonsTraced);
+        EXPECT_EQ(beauty(withCache), beauty(fresh)) << "beams " << beams;
+        EXPECT_EQ(cache->passes(), 3u);  // now the moved light's maps
+    }
 }
 
 TEST(PhotonCache, ChangedPhotonSettingsInvalidate) {
