@@ -681,7 +681,6 @@ private:
         return true;
     }
 
-
     /// An emissive medium as a photon source: uniform points in `box` where the medium is present,
     /// uniform directions. Volume emission is photon-traced so that its scattered light (which the
     /// single-scattering pass does not compute) is in the photon map.
