@@ -110,7 +110,7 @@ public:
     /// photons carried flux only. The benchmark's open media, where beams lead points (README), are
     /// below it: dense cloud 65.6, VDB cloud 13.1, emissive smoke 9.8, cube 6.9, atmosphere 0.87, fog
     /// 0.42. In translucent objects (Scene::meshTranslucent) beams measured 1.30x the points' RMSE on
-    /// the marble figurine (thickness 89.5) and 1.02x on the ball (34.6), so they keep points.
+    /// the marble figurine (thickness 89.5) and 1.02-1.04x on the ball (34.6; two runs), so they keep points.
     static constexpr double ThickOpticalDepth = 100;
 
     /// Whether photons in region `region` are stored and gathered as beams (photonBeams, beamRegions_).
