@@ -2,6 +2,7 @@
 // segments along a ray for the single free-flight routine (freeFlight.h).
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -80,6 +81,12 @@ struct MajorantSegment {
     double tMin = 0, tMax = 0;
     double sigmaMaj = 0;
     double decay = 0;
+    /// The majorant's optical depth over the first `len` of the piece: sigmaMaj len (1 - e^{-x}) / x,
+    /// x = decay len (expm1: exact as x -> 0).
+    double opticalDepth(double len) const {
+        double x = decay * len;
+        return sigmaMaj * len * (x == 0 ? 1.0 : -std::expm1(-x) / x);
+    }
 };
 
 using MajorantCallback = FunctionRef<bool(const MajorantSegment&)>;

@@ -299,9 +299,8 @@ private:
             double end = std::min(seg.tMax, t);
             double len = end - seg.tMin;
             if (len < 0) return false;
-            double x = seg.decay * len;
-            tau += seg.sigmaMaj * len * (x == 0 ? 1.0 : -std::expm1(-x) / x);
-            if (t < seg.tMax || seg.tMax >= t * (1 - 1e-12)) sigma = seg.sigmaMaj * std::exp(-x);
+            tau += seg.opticalDepth(len);
+            if (t < seg.tMax || seg.tMax >= t * (1 - 1e-12)) sigma = seg.sigmaMaj * std::exp(-seg.decay * len);
             return t >= seg.tMax;
         });
         return sigma * std::exp(-tau);

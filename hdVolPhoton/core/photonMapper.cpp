@@ -89,8 +89,7 @@ public:
             // Beams where a region's media are optically thin, points where thick (beamsIn).
             MediumAggregate open;
             for (int i : scene.desc().unboundedMedia) open.add(scene.desc().media[i].get());
-            Bounds3 b = open.bounds();
-            beamRegions_.push_back(open.size() && opticalThickness(open, {vmax(b.lo, sceneBox_.lo), vmin(b.hi, sceneBox_.hi)}) <= ThickOpticalDepth);
+            beamRegions_.push_back(open.size() && opticalThickness(open, withinScene(open.bounds())) <= ThickOpticalDepth);
             for (size_t mi = 0; mi < scene.desc().meshes.size(); ++mi) {
                 int interior = scene.desc().meshes[mi].interiorMedium;
                 MediumAggregate media = open;
@@ -113,10 +112,14 @@ public:
     /// the marble figurine (thickness 89.5) and 1.02-1.04x on the ball (34.6; two runs), so they keep points.
     static constexpr double ThickOpticalDepth = 100;
 
-    /// Whether photons in region `region` are stored and gathered as beams (photonBeams, beamRegions_).
+    /// Whether photons in region `region` are stored and gathered as beams (beamRegions_, empty
+    /// without photonBeams).
     bool beamsIn(int region) const {
-        return settings_.photonBeams && region + 1 < static_cast<int>(beamRegions_.size()) && beamRegions_[region + 1];
+        return region + 1 < static_cast<int>(beamRegions_.size()) && beamRegions_[region + 1];
     }
+
+    /// A box clipped to the scene's (an unbounded medium's bounds are infinite).
+    Bounds3 withinScene(const Bounds3& b) const { return {vmax(b.lo, sceneBox_.lo), vmin(b.hi, sceneBox_.hi)}; }
 
     /// A region's optical thickness: the largest majorant optical depth along the three axes and the
     /// four diagonals through the centre of `box` (an upper bound of the extinction's integral there).
@@ -132,8 +135,7 @@ public:
             Ray ray{c + t0 * d, d};
             double tau = 0;
             media.majorants(ray, 0.0, t1 - t0, [&](const MajorantSegment& m) {
-                double len = m.tMax - m.tMin;
-                tau += m.decay == 0 ? m.sigmaMaj * len : m.sigmaMaj * -std::expm1(-m.decay * len) / m.decay;
+                tau += m.opticalDepth(m.tMax - m.tMin);
                 return true;
             });
             thickest = std::max(thickest, tau);
@@ -701,9 +703,7 @@ private:
     void findEmitters() {
         auto add = [&](const Medium* m, int mesh) {
             if (!m->isEmissive()) return;
-            Bounds3 b = m->bounds(), box;
-            box.lo = vmax(b.lo, sceneBox_.lo);
-            box.hi = vmin(b.hi, sceneBox_.hi);
+            Bounds3 box = withinScene(m->bounds());
             if (box.empty()) return;
             Vec3 size = box.hi - box.lo;
             Emitter e{m, mesh, box, size.x * size.y * size.z, 0.0};
@@ -727,9 +727,7 @@ private:
     /// outside them), as a beam carrying `flux`.
     void addBeamPiece(const Ray& ray, double t0, double t1, const Spectrum& flux, const Medium& media, int region,
                       float radius, std::vector<PhotonBeam>* out) const {
-        Bounds3 b = media.bounds(), box;
-        box.lo = vmax(b.lo, sceneBox_.lo);
-        box.hi = vmin(b.hi, sceneBox_.hi);
+        Bounds3 box = withinScene(media.bounds());
         if (!box.intersect(ray, t0, t1, &t0, &t1) || !(t1 > t0) || flux.isBlack()) return;
         PhotonBeam beam;
         Vec3 o = ray.at(t0);
