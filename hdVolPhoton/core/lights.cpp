@@ -373,6 +373,7 @@ public:
         return s;
     }
     bool intersect(const Ray&, double, double*, Spectrum*, double*) const override { return false; }
+    bool isGeometry() const override { return true; }
     double pdfAt(const Vec3& ref, const Vec3& p, const Vec3& n) const override {
         Vec3 d = p - ref;
         double dist2 = lengthSquared(d);

@@ -71,6 +71,8 @@ public:
     /// solid-angle density sample() would have produced the direction with.
     virtual bool intersect(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf) const = 0;
     virtual bool isDelta() const = 0;
+    /// Lights that are scene geometry (mesh lights) are met by surface hits, never by intersect().
+    virtual bool isGeometry() const { return false; }
     /// The environment (dome) light: RenderSettings::domeVisibleToCamera may hide it from camera rays.
     virtual bool isDome() const { return false; }
     /// Position of a point (or point spot) light, for equiangular sampling; nullopt for others.

@@ -1068,6 +1068,64 @@ TEST(IntegratorSingleScattering, SphereLightEquiangularAgreesWithPhotonMap) {
     EXPECT_GT(a.mean, 0.0);
 }
 
+TEST(IntegratorSingleScattering, PhotonMapSamplesThePhaseAsWellAsTheLights) {
+    // The photon map's single-scattering pass combines light sampling with phase sampling (MIS).
+    // With light sampling alone a near-delta phase under a dome is seen only when a light sample
+    // falls in its lobe: unbiased, but heavy-tailed (the old pass, 16 seeds x 16 passes: 0.73 +- 0.59
+    // and 0.33 +- 0.11 where the path tracer reads 0.246 and 0.180 for g = -/+0.999). So besides
+    // agreeing, the photon map's estimate must be usable: a standard error within 1% of its mean
+    // (0.1-0.2% measured).
+    // The second scene mixes every kind of light: a sphere light and a dome (both strategies), a
+    // delta distant light and an emissive mesh (light sampling alone: a weight below one for them
+    // would lose light).
+    auto fogBox = [](PhasePtr phase) {
+        return std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(1.0, Spectrum(1.0), Spectrum(1.0), Spectrum(0.0), phase),
+                                                   Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)});
+    };
+    std::vector<std::pair<std::string, SceneDesc>> scenes;
+    for (double g : {-0.999, 0.999}) {
+        SceneDesc d;
+        d.media.push_back(fogBox(makeHenyeyGreensteinPhase(g)));
+        d.unboundedMedia.push_back(0);
+        d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+        d.camera = lookAt(Vec3(0.2, 0.1, 3), Vec3(0, 0, 0));
+        scenes.emplace_back("dome, HG g = " + std::to_string(g), d);
+    }
+    {
+        SceneDesc d;
+        d.media.push_back(fogBox(makeHenyeyGreensteinPhase(0.7)));
+        d.unboundedMedia.push_back(0);
+        // A dim dome: the path tracer's phase-sampled rays end at the sphere light (hitLight takes the
+        // nearest) where light samples of the dome pass through it (a known inconsistency, not this
+        // test's subject: here the sphere-and-dome image reads 0.5% below the two lights' separate
+        // images, 4 sigma at 1024 spp; 0.8% of the whole image with a dome of 0.2).
+        d.lights.push_back(makeSphereLight(Vec3(0.3, 0.2, -1.8), 0.25, Spectrum(7.0)));
+        d.lights.push_back(makeDistantLight(Vec3(0.3, -1, -0.4), 0.0, Spectrum(1.0)));
+        d.lights.push_back(makeDomeLight(Spectrum(0.05)));
+        MeshDesc panel;  // emissive, facing -Y, above the fog
+        panel.name = "panel";
+        panel.points = {Vec3(-1, 1.5, -1), Vec3(1, 1.5, -1), Vec3(1, 1.5, 1), Vec3(-1, 1.5, 1)};
+        panel.indices = {0, 1, 2, 0, 2, 3};
+        panel.material.albedo = Spectrum(0.0);
+        panel.material.emission = Spectrum(2.0);
+        d.meshes.push_back(panel);
+        d.instances.push_back({0, Affine()});
+        d.camera = lookAt(Vec3(0.2, 0.1, 3), Vec3(0, 0, 0));
+        scenes.emplace_back("sphere, distant, dome and mesh lights, HG g = 0.7", d);
+    }
+    for (const auto& [name, d] : scenes) {
+        RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+        RenderSettings pm = smallSettings(RenderSettings::Integrator::PhotonMap, 16, 0);
+        pm.multipleScattering = false;
+        auto a = imageMean(d, pt, [](const Film& f) { return aovMean(f, Film::Single); });
+        auto b = imageMean(d, pm, [](const Film& f) { return aovMean(f, Film::Single); });
+        std::printf("%s: single, path tracer %.5f +- %.5f, photon map %.5f +- %.5f\n", name.c_str(), a.mean, a.stderr_, b.mean, b.stderr_);
+        EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_)) << name;
+        EXPECT_LT(b.stderr_, 0.01 * b.mean) << name;
+        EXPECT_GT(a.mean, 0.0) << name;
+    }
+}
+
 TEST(IntegratorCancel, CancelStopsTilesAndPhotonBatches) {
     // The callback is polled per tile and per photon batch: a cancel after a few polls stops the
     // render early and the stats say so. Tiles finished in the cancelled pass keep their sample (each
