@@ -1083,14 +1083,8 @@ TEST(IntegratorSingleScattering, PhotonMapSamplesThePhaseAsWellAsTheLights) {
                                                    Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)});
     };
     std::vector<std::pair<std::string, SceneDesc>> scenes;
-    for (double g : {-0.999, 0.999}) {
-        SceneDesc d;
-        d.media.push_back(fogBox(makeHenyeyGreensteinPhase(g)));
-        d.unboundedMedia.push_back(0);
-        d.lights.push_back(makeDomeLight(Spectrum(1.0)));
-        d.camera = lookAt(Vec3(0.2, 0.1, 3), Vec3(0, 0, 0));
-        scenes.emplace_back("dome, HG g = " + std::to_string(g), d);
-    }
+    for (double g : {-0.999, 0.999})
+        scenes.emplace_back("dome, HG g = " + std::to_string(g), furnaceScene(fogBox(makeHenyeyGreensteinPhase(g)), Vec3(0.2, 0.1, 3)));
     {
         SceneDesc d;
         d.media.push_back(fogBox(makeHenyeyGreensteinPhase(0.7)));
