@@ -31,7 +31,7 @@ DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng) const {
     return d;
 }
 
-bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
+bool Integrator::hitLight(const Ray& ray, double tFrom, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
                           bool cameraRay) const {
     bool found = false;
     for (size_t i = 0; i < scene_.lights().size(); ++i) {
@@ -39,7 +39,8 @@ bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, 
         double th;
         Spectrum L;
         double p;
-        if (scene_.lights()[i]->intersect(ray, tMax, &th, &L, &p) && (!found || th < *t)) {
+        // A light passed (th <= tFrom) is not met again: the same ray gives the same distance.
+        if (scene_.lights()[i]->intersect(ray, tMax, &th, &L, &p) && th > tFrom && (!found || th < *t)) {
             found = true;
             *t = th;
             *Le = L;
@@ -49,6 +50,17 @@ bool Integrator::hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, 
         }
     }
     return found;
+}
+
+void Integrator::lightsAtInfinity(const Ray& ray, bool cameraRay,
+                                  FunctionRef<void(int light, const Spectrum& Le, double pdf)> f) const {
+    for (size_t i = 0; i < scene_.lights().size(); ++i) {
+        const Light& light = *scene_.lights()[i];
+        if (cameraRay && !settings_.domeVisibleToCamera && light.isDome()) continue;
+        double t, pdf;
+        Spectrum Le;
+        if (light.intersect(ray, Infinity, &t, &Le, &pdf) && std::isinf(t)) f(static_cast<int>(i), Le, pdf);
+    }
 }
 
 Spectrum Integrator::shadowTransmittance(const Vec3& p, const Vec3& w, double dist, MediumStack stack, Rng& rng,
@@ -96,7 +108,7 @@ PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stac
     PathSegment seg;
     seg.hasHit = scene_.intersect(path.ray, path.tMin, path.tMax, &seg.hit);
     seg.tEnd = seg.hasHit ? seg.hit.t : path.tMax;
-    seg.hasLight = hitLight(path.ray, seg.hasHit ? seg.tEnd : Infinity, &seg.tLight, &seg.lightLe, &seg.lightPdf, &seg.light,
+    seg.hasLight = hitLight(path.ray, path.lightsFrom, seg.hasHit ? seg.tEnd : Infinity, &seg.tLight, &seg.lightLe, &seg.lightPdf, &seg.light,
                             cameraRay);
     if (seg.hasLight && !std::isinf(seg.tLight)) seg.tEnd = std::min(seg.tEnd, seg.tLight);
     seg.leakExit = seg.hasHit ? Infinity : leakDistance(stack, path.ray);

@@ -75,17 +75,27 @@ enum class SurfaceStep {
 
 /// The ray a camera path follows: surfaces are searched in [tMin, tMax] (tMax is the camera's far
 /// clip, or infinity after a bounce) and media are tracked from mediumFrom (the near clip on the
-/// camera ray, the vertex itself after it).
+/// camera ray, the vertex itself after it). Lights are met beyond lightsFrom (past the lights the
+/// path went through on this ray: lights are not scene geometry, Integrator::hitLight).
 struct PathRay {
     Ray ray;
     double tMin, tMax, mediumFrom;
+    double lightsFrom = 0;
 
     /// Straight on through an index-matched boundary met at distance t (the far clip still counts).
     void passBoundary(const SurfaceScatter& s, double t) {
         ray = s.next;
         tMin = s.tMin;
         mediumFrom = 0;
+        lightsFrom = 0;
         if (!std::isinf(tMax)) tMax -= t;
+    }
+    /// On along the same ray through a light with extent met at distance t (its emission counted):
+    /// media are tracked from t and lights met beyond it. Surfaces are still searched from tMin (one
+    /// at t itself, behind a light mounted flush on it, is met next).
+    void passLight(double t) {
+        mediumFrom = t;
+        lightsFrom = t;
     }
     /// Out of a broken (open) medium mesh through a hole at distance t: the path is outside it now.
     /// t = 0: a closed mesh crossed unnoticed (Integrator::leakDistance); the same ray goes on, with
@@ -95,6 +105,7 @@ struct PathRay {
         if (t > 0) tMin = 0;
         ray = {ray.at(t), ray.d};
         mediumFrom = 0;
+        lightsFrom = std::max(0.0, lightsFrom - t);
         if (!std::isinf(tMax)) tMax -= t;
     }
     /// A new direction from a vertex (a medium event or a surface).
@@ -102,6 +113,7 @@ struct PathRay {
         ray = next;
         tMin = nextTMin;
         mediumFrom = 0;
+        lightsFrom = 0;
         tMax = Infinity;
     }
 };
@@ -139,10 +151,16 @@ protected:
     bool surfaceSamplesAllLights() const { return scene_.lights().size() <= AllLightsMax; }
     /// Probability with which a lambertian vertex's next-event estimation chooses light i (for MIS).
     double surfaceLightPickProb(int light) const { return surfaceSamplesAllLights() ? 1.0 : lightPickProb(light); }
-    /// Nearest light with extent hit by ray before tMax (including escape to dome/distant lights).
-    /// The nearest light the ray meets before tMax. cameraRay: the ray is still the camera's own (first
-    /// segment), so a dome hidden by RenderSettings::domeVisibleToCamera is not met.
-    bool hitLight(const Ray& ray, double tMax, double* t, Spectrum* Le, double* pdf, int* light, bool cameraRay) const;
+    /// The nearest light with extent the ray meets in (tFrom, tMax); lights at infinity (dome, distant
+    /// lights with extent) only when tMax is infinite, and then the first of them (lightsAtInfinity()
+    /// gives them all). cameraRay: the ray is still the camera's own (first segment), so a dome hidden
+    /// by RenderSettings::domeVisibleToCamera is not met.
+    /// Lights are not scene geometry: shadow rays and photons pass through them, and so do camera
+    /// paths (PathRay::passLight), adding the emission of every light they pass, as Cycles' paths do.
+    bool hitLight(const Ray& ray, double tFrom, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
+                  bool cameraRay) const;
+    /// Every light at infinity an escaping ray meets, with its emission and its own solid-angle density.
+    void lightsAtInfinity(const Ray& ray, bool cameraRay, FunctionRef<void(int light, const Spectrum& Le, double pdf)> f) const;
     /// Transmittance from p along unit w over dist, through media and index-matched boundaries;
     /// 0 if any other surface blocks. `stack` is the medium stack at p; surfaces are searched from
     /// t = tMin (a spawn offset off the surface p lies on), media from t = 0.

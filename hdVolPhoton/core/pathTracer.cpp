@@ -49,7 +49,7 @@ public:
     PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
         PathRadiance out;
         PathRay path{cameraRay, nearClip, farClip, nearClip};
-        auto& [ray, tMin, tMax, mediumFrom] = path;
+        auto& [ray, tMin, tMax, mediumFrom, lightsFrom] = path;
         Spectrum beta(1.0);
         MediumStack stack = cameraStack_;
         Branch branch = Branch::Undecided;
@@ -215,11 +215,21 @@ public:
             lightHitIsSingle = false;
             // Reached a light, a surface, or escaped.
             if (ahead.reachesLight()) {
-                double pick = prevSurface ? surfaceLightPickProb(ahead.light) : lightPickProb(ahead.light);
-                double w = specular ? 1.0 : powerHeuristic(prevPdf, pick * ahead.lightPdf);
-                add(beta * ahead.lightLe * w, lightWasSingle);
-                if (firstSegment && !std::isinf(ahead.tLight)) out.alpha = 1;
-                break;
+                auto addLight = [&](int light, const Spectrum& Le, double lightPdf) {
+                    double pick = prevSurface ? surfaceLightPickProb(light) : lightPickProb(light);
+                    double w = specular ? 1.0 : powerHeuristic(prevPdf, pick * lightPdf);
+                    add(beta * Le * w, lightWasSingle);
+                };
+                if (std::isinf(ahead.tLight)) {  // escaped: every light at infinity
+                    lightsAtInfinity(ray, firstSegment, addLight);
+                    break;
+                }
+                // Through the light, as shadow rays and photons go (Integrator::hitLight).
+                addLight(ahead.light, ahead.lightLe, ahead.lightPdf);
+                if (firstSegment) out.alpha = 1;
+                path.passLight(ahead.tLight);
+                lightHitIsSingle = lightWasSingle;
+                continue;
             }
             if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;

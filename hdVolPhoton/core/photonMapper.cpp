@@ -223,7 +223,7 @@ public:
         if (cameraPaths_) return cameraPaths_->Li(cameraRay, nearClip, farClip, rng);
         PathRadiance out;
         PathRay path{cameraRay, nearClip, farClip, nearClip};
-        auto& [ray, tMin, tMax, mediumFrom] = path;
+        auto& [ray, tMin, tMax, mediumFrom, lightsFrom] = path;
         Spectrum beta(1.0);
         MediumStack stack = cameraStack_;
         bool firstSegment = true, onlySpecular = true;
@@ -259,9 +259,16 @@ public:
             if (ahead.reachesLight()) {
                 // Lights are found by light sampling at diffuse vertices, so a hit counts only after
                 // the camera or specular bounces.
+                if (std::isinf(ahead.tLight)) {  // escaped: every light at infinity
+                    if (onlySpecular)
+                        lightsAtInfinity(ray, firstSegment, [&](int, const Spectrum& Le, double) { out.surface += beta * Le; });
+                    break;
+                }
+                // Through the light, as shadow rays and photons go (Integrator::hitLight).
                 if (onlySpecular) out.surface += beta * ahead.lightLe;
-                if (firstSegment && !std::isinf(ahead.tLight)) out.alpha = 1;
-                break;
+                if (firstSegment) out.alpha = 1;
+                path.passLight(ahead.tLight);
+                continue;
             }
             if (!ahead.hasHit) break;
             if (firstSegment) out.alpha = 1;
