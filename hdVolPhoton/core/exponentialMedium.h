@@ -32,6 +32,7 @@ public:
     Bounds3 bounds() const override { return bounds_; }
     bool isEmissive() const override { return !c_.emission.isBlack() && a_ > 0; }
     double maxAlbedo() const override;
+    double phasePeak() const override { return volphoton::phasePeak(c_.phase.get()); }
     std::string describe() const override;
 
     /// Relative density a e^{-b h} at p, with the exponent clamped so it stays finite.

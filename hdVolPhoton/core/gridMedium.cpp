@@ -529,6 +529,8 @@ double GridMedium::maxAlbedo() const {
     return (m.maxDensity * m.desc.densityScale > 0) ? a : 0.0;
 }
 
+double GridMedium::phasePeak() const { return volphoton::phasePeak(impl_->desc.phase.get()); }
+
 std::string GridMedium::describe() const {
     const Impl& m = *impl_;
     std::ostringstream s;

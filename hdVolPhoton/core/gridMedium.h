@@ -104,6 +104,7 @@ public:
     Bounds3 bounds() const override;
     bool isEmissive() const override;
     double maxAlbedo() const override;
+    double phasePeak() const override;
     std::string describe() const override;
 
     /// Largest density grid value within reach of the support, background included (after

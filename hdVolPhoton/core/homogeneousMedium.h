@@ -38,6 +38,7 @@ public:
     Bounds3 bounds() const override { return bounds_; }
     bool isEmissive() const override { return !c_.emission.isBlack(); }
     double maxAlbedo() const override;
+    double phasePeak() const override { return volphoton::phasePeak(c_.phase.get()); }
     std::string describe() const override;
 
 private:

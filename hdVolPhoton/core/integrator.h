@@ -59,9 +59,10 @@
 // | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
 // |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
 // |                     |        |            |              | photon points, where media are optically thin     |
-// |                     |        |            |              | (points in regions thicker than 100 and in        |
-// |                     |        |            |              | translucent objects); the beams' radius shrinks   |
-// |                     |        |            |              | as r (i+alpha)/(i+1)                              |
+// |                     |        |            |              | (points in regions thicker than 100, in           |
+// |                     |        |            |              | translucent objects and where a phase is peaked   |
+// |                     |        |            |              | beyond HG g = 0.6); the beams' radius shrinks as  |
+// |                     |        |            |              | r (i+alpha)/(i+1). false: points everywhere       |
 // | marchStep           | double | 0 (auto)   | scene units  | photonMap: single-scattering step (auto: 1/256 of |
 // |                     |        |            |              | the media's diameter, else of the scene's)        |
 // | singleScattering    | bool   | true       |              | photonMap: run the single-scattering pass         |

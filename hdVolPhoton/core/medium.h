@@ -111,6 +111,8 @@ public:
     virtual bool isEmissive() const = 0;
     /// Largest single-scattering albedo anywhere (channel max); used to skip multiple scattering.
     virtual double maxAlbedo() const = 0;
+    /// The largest phasePeak() of its phase functions (1: isotropic).
+    virtual double phasePeak() const = 0;
     virtual std::string describe() const = 0;
 };
 

@@ -115,6 +115,12 @@ double MediumAggregate::maxAlbedo() const {
     return m;
 }
 
+double MediumAggregate::phasePeak() const {
+    double m = 1;
+    for (int i = 0; i < count_; ++i) m = std::max(m, media_[i]->phasePeak());
+    return m;
+}
+
 std::string MediumAggregate::describe() const {
     std::string s = "aggregate(";
     for (int i = 0; i < count_; ++i) s += (i ? ", " : "") + media_[i]->describe();

@@ -25,6 +25,7 @@ public:
     Bounds3 bounds() const override;
     bool isEmissive() const override;
     double maxAlbedo() const override;
+    double phasePeak() const override;
     std::string describe() const override;
 
 private:

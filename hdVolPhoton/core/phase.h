@@ -64,6 +64,12 @@ public:
 
 using PhasePtr = std::shared_ptr<const PhaseFunction>;
 
+/// How peaked a phase function is: 4 pi max(p(1), p(-1)), 1 for isotropic scattering (and for null,
+/// which media read as isotropic); Henyey-Greenstein's is (1 + |g|) / (1 - |g|)^2 (g = 0.6: 10).
+inline double phasePeak(const PhaseFunction* phase) {
+    return phase ? 4 * Pi * std::max(phase->eval(1.0), phase->eval(-1.0)) : 1.0;
+}
+
 /// Factories. They validate and clamp parameters; invalid input throws std::invalid_argument with a
 /// message naming the parameter (the USD layer prefixes the prim and attribute).
 PhasePtr makeIsotropicPhase();

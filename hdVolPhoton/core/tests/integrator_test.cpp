@@ -602,7 +602,7 @@ TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
 TEST(IntegratorPhotonMap, BeamsWhereMediaAreThinPointsWhereThick) {
     // photonBeams stores beams per region: in the open fog (optical thickness about 5) beams, inside
     // an index-matched box of sigma_t 200 (thickness about 280 > 100) points, whose beams would be
-    // heavy-tailed. Alone, the thick box renders the points' image bit for bit; with the fog, the
+    // heavy-tailed, and in a fog with a forward-peaked phase points. Alone, the thick box renders the points' image bit for bit; with the fog, the
     // mixed estimate matches the path tracer's multiple scattering.
     auto thickBox = [](SceneDesc& d) {
         auto c = MediumCoefficients::fromAlbedo(200.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
@@ -630,7 +630,25 @@ TEST(IntegratorPhotonMap, BeamsWhereMediaAreThinPointsWhereThick) {
         EXPECT_GT(a.stats().photonsStored, 0u);
         EXPECT_EQ(a.film().resolveRgb(Film::Beauty), b.film().resolveRgb(Film::Beauty)) << "a thick region keeps points";
         const auto& run = a.stats().passesRun;
-        EXPECT_NE(std::find(run.begin(), run.end(), "photon beams; points in thick (optically thick or translucent)"), run.end());
+        EXPECT_NE(std::find(run.begin(), run.end(), "photon beams; points in thick (optically thick, translucent or with a phase peaked beyond HG g = 0.6)"), run.end());
+    }
+    {
+        // A thin fog with a forward-peaked phase (HG g = 0.9, peak 190 > 10) keeps points too: beams
+        // weighted by p / sin(theta) would be heavy-tailed there (ModeratePhasePeak). The same fog
+        // with g = 0.3 takes beams.
+        auto fog = [](double g) {
+            return furnaceScene(std::make_shared<HomogeneousMedium>(MediumCoefficients::fromAlbedo(
+                                    1.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(g))),
+                                Vec3(0.2, 0.1, 0.3));
+        };
+        auto peaked = std::make_shared<Scene>(fog(0.9)), moderate = std::make_shared<Scene>(fog(0.3));
+        Renderer a(peaked, beams), b(peaked, points), c(moderate, beams), e(moderate, points);
+        for (Renderer* r : {&a, &b, &c, &e}) r->render();
+        EXPECT_GT(a.stats().photonsStored, 0u);
+        EXPECT_EQ(a.film().resolveRgb(Film::Beauty), b.film().resolveRgb(Film::Beauty)) << "a peaked phase keeps points";
+        const auto& run = a.stats().passesRun;
+        EXPECT_NE(std::find(run.begin(), run.end(), "photon beams; points in the open media (optically thick, translucent or with a phase peaked beyond HG g = 0.6)"), run.end());
+        EXPECT_NE(c.film().resolveRgb(Film::Multiple), e.film().resolveRgb(Film::Multiple)) << "a moderate phase takes beams";
     }
     SceneDesc d = mediaOnlyScene();
     addFloor(d);

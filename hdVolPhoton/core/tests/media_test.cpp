@@ -348,6 +348,7 @@ public:
     Bounds3 bounds() const override { return {Vec3(-1, -1, -1), Vec3(1, 1, 1)}; }
     bool isEmissive() const override { return false; }
     double maxAlbedo() const override { return 0; }
+    double phasePeak() const override { return 1; }
     std::string describe() const override { return "loose"; }
 };
 }  // namespace

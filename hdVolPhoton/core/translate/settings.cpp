@@ -93,7 +93,8 @@ std::vector<SettingInfo> makeTable() {
                               &RS::combinedPhotonShare));
     t.push_back(boolSetting("photonBeams", "", "Photon beams",
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points where media are "
-                            "optically thin (points where thicker than 100 and in translucent objects)",
+                            "optically thin (points where thicker than 100, in translucent objects and where a phase is peaked beyond "
+                            "Henyey-Greenstein g = 0.6)",
                             &RS::photonBeams));
     t.push_back(intSetting("stratifiedDims", 0, 4096, "", "volphoton:stratifiedDims", "Stratified dimensions (0: independent)",
                            "", "dimensions per camera sample taken from scrambled Sobol' points; the path tracer gives each path segment the same 32 (516: 16 segments; 0: independent)",
