@@ -156,7 +156,9 @@ protected:
     /// gives them all). cameraRay: the ray is still the camera's own (first segment), so a dome hidden
     /// by RenderSettings::domeVisibleToCamera is not met.
     /// Lights are not scene geometry: shadow rays and photons pass through them, and so do camera
-    /// paths (PathRay::passLight), adding the emission of every light they pass, as Cycles' paths do.
+    /// paths (PathRay::passLight), adding the emission of every light they pass, as Cycles' paths do
+    /// (integrate_light in intern/cycles/kernel/integrator/shade_light.h moves the ray's tmin past the
+    /// light and the path goes on).
     bool hitLight(const Ray& ray, double tFrom, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
                   bool cameraRay) const;
     /// Every light at infinity an escaping ray meets, with its emission and its own solid-angle density.
