@@ -1233,3 +1233,39 @@ def test_an_unknown_render_setting_is_named_by_both_doors(settings_renders):
     _, _, hlog, clog = settings_renders["unknown"]
     for door, log in (("CLI", clog), ("delegate (usdrecord)", hlog)):
         check(complaints(log, "noSuchSetting"), "%s does not name volphoton:noSuchSetting:\n%s" % (door, log[-3000:]))
+
+
+# --------------------------------------------------------------------------------------------------
+# Lights at infinity: every one an escaping ray meets
+# --------------------------------------------------------------------------------------------------
+
+# A sun of angular diameter 8 degrees straight ahead (its light travels +Z, towards the camera: the
+# disk's radius is about 7 pixels around the image centre) and a dim sky.  "sky" sorts before "sun",
+# so both doors list the dome first.
+SUN_AND_SKY = '''    def DomeLight "sky"
+    {
+        float inputs:intensity = 0.2
+    }
+    def DistantLight "sun"
+    {
+        float inputs:intensity = 1
+        float inputs:angle = 8
+        bool inputs:normalize = 1
+        float3 xformOp:rotateXYZ = (0, 180, 0)
+        uniform token[] xformOpOrder = ["xformOp:rotateXYZ"]
+    }'''
+
+
+def test_a_wide_sun_is_seen_in_front_of_the_sky_in_both_doors(tmp_path, hydra_env):
+    """Camera rays that escape see every light at infinity (Integrator::lightsAtInfinity).  The sun's
+    radiance is its irradiance 1 / (pi sin^2(4 deg)) = 65.5 (normalize), the sky's 0.2.  Measured
+    2026-12-05 before the fix: both doors saw the sky alone (0.2) inside the sun's disk."""
+    hydra, cli, _, _ = render_both(hydra_env, tmp_path, "sun_and_sky", lambda s: stage_text(SUN_AND_SKY, s))
+    centre = (slice(H // 2 - 2, H // 2 + 2), slice(W // 2 - 2, W // 2 + 2))
+    corner = (slice(0, 4), slice(0, 4))
+    sun = 1 / (math.pi * math.sin(math.radians(4)) ** 2)
+    for door, img in (("delegate", hydra), ("CLI", cli)):
+        c, k = img[:, centre[0], centre[1]].mean(), img[:, corner[0], corner[1]].mean()
+        check(abs(c / (sun + 0.2) - 1) < 0.01, "%s: the sun's disk reads %.3f (sun %.3f + sky 0.2)" % (door, c, sun))
+        check(abs(k / 0.2 - 1) < 0.01, "%s: the sky reads %.4f (0.2)" % (door, k))
+    assert_doors_agree(hydra, cli, "sun and sky")
