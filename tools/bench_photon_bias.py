@@ -35,15 +35,15 @@ def main():
                     help="a RenderSettings attribute (Python spelling, e.g. photon_radius_mfp=2) over the scene's")
     a = ap.parse_args()
     enum = {"photonMap": "PhotonMap", "pathTracer": "PathTracer", "combined": "Combined", "auto": "Auto"}[a.integrator]
+    width, height = SIZE[0] * a.size, SIZE[1] * a.size
     for name in a.scenes.split(","):
         ref = np.load(os.path.join(a.out, name, "reference_ours.npz"))["mean"]
-        scale = a.size
-        rs, tr = load_bench_scene(name, SIZE[0] * scale, SIZE[1] * scale)
+        rs, tr = load_bench_scene(name, width, height)
         scene = _core.Scene(tr.desc)
         images, rmse, passes, seconds = [], [], [], []
         for seed in range(a.seeds):
             s = rs.settings
-            s.width, s.height, s.seed, s.threads = SIZE[0] * scale, SIZE[1] * scale, seed, 2
+            s.width, s.height, s.seed, s.threads = width, height, seed, 2
             s.noise_target, s.time_limit = 0, a.seconds
             s.samples_per_pixel = s.max_samples_per_pixel = 100000
             s.integrator = getattr(_core.RenderSettings.Integrator, enum)
@@ -53,7 +53,7 @@ def main():
             r = _core.Renderer(scene, s)
             r.render()
             img = np.asarray(r.film.beauty, np.float64)
-            img = img.reshape(SIZE[1], scale, SIZE[0], scale, 3).mean((1, 3))
+            img = img.reshape(SIZE[1], a.size, SIZE[0], a.size, 3).mean((1, 3))
             images.append(img)
             rmse.append(np.sqrt(((img - ref) ** 2).mean()))
             passes.append(r.stats["passes"])

@@ -35,7 +35,7 @@ bool Integrator::hitLight(const Ray& ray, double tFrom, double tMax, double* t, 
                           bool cameraRay) const {
     bool found = false;
     for (size_t i = 0; i < scene_.lights().size(); ++i) {
-        if (cameraRay && !settings_.domeVisibleToCamera && scene_.lights()[i]->isDome()) continue;
+        if (hiddenFromCamera(*scene_.lights()[i], cameraRay)) continue;
         double th;
         Spectrum L;
         double p;
@@ -56,7 +56,7 @@ void Integrator::lightsAtInfinity(const Ray& ray, bool cameraRay,
                                   FunctionRef<void(int light, const Spectrum& Le, double pdf)> f) const {
     for (size_t i = 0; i < scene_.lights().size(); ++i) {
         const Light& light = *scene_.lights()[i];
-        if (cameraRay && !settings_.domeVisibleToCamera && light.isDome()) continue;
+        if (hiddenFromCamera(light, cameraRay)) continue;
         double t, pdf;
         Spectrum Le;
         if (light.intersect(ray, Infinity, &t, &Le, &pdf) && std::isinf(t)) f(static_cast<int>(i), Le, pdf);

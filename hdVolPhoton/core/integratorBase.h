@@ -161,6 +161,10 @@ protected:
     /// light and the path goes on).
     bool hitLight(const Ray& ray, double tFrom, double tMax, double* t, Spectrum* Le, double* pdf, int* light,
                   bool cameraRay) const;
+    /// A dome the camera's own ray does not meet (RenderSettings::domeVisibleToCamera).
+    bool hiddenFromCamera(const Light& light, bool cameraRay) const {
+        return cameraRay && !settings_.domeVisibleToCamera && light.isDome();
+    }
     /// Every light at infinity an escaping ray meets, with its emission and its own solid-angle density.
     void lightsAtInfinity(const Ray& ray, bool cameraRay, FunctionRef<void(int light, const Spectrum& Le, double pdf)> f) const;
     /// Transmittance from p along unit w over dist, through media and index-matched boundaries;

@@ -602,8 +602,9 @@ TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
 TEST(IntegratorPhotonMap, BeamsWhereMediaAreThinPointsWhereThick) {
     // photonBeams stores beams per region: in the open fog (optical thickness about 5) beams, inside
     // an index-matched box of sigma_t 200 (thickness about 280 > 100) points, whose beams would be
-    // heavy-tailed, and in a fog with a forward-peaked phase points. Alone, the thick box renders the points' image bit for bit; with the fog, the
-    // mixed estimate matches the path tracer's multiple scattering.
+    // heavy-tailed, and in a fog with a forward-peaked phase points. Alone, the thick box renders the
+    // points' image bit for bit; with the fog, the mixed estimate matches the path tracer's multiple
+    // scattering.
     auto thickBox = [](SceneDesc& d) {
         auto c = MediumCoefficients::fromAlbedo(200.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
         d.media.push_back(std::make_shared<HomogeneousMedium>(c));
