@@ -3,9 +3,10 @@
 that fit the job"): for each benchmark scene (testenv/bench/*.usda) at its settings, 4 passes at
 defaults, the photon pass's ns per traced photon, the camera pass's ns per pixel-sample, and the
 photons per pixel that would make the two passes take equally long; then the counted work
-(core/workCount.h: rays and medium lookups of a camera pass and of a photon, from the pilots) and
-the balance the automatic photon count derives from it with RayCost, against the measured balance,
-and the RayCost that fits the measured balances best (least squares of the log ratio).
+(core/workCount.h: rays and medium lookups, the latter weighted by each medium's lookup cost, of a
+camera pass and of a photon, from the pilots) and the balance the automatic photon count derives from
+it, against the measured balance, and the RayCost, PhotonLookupCost and PhotonBaseCost that fit the
+measured balances best (least squares of the log ratio).
 
     python tools/bench_photon_cost.py                 # 80x60
     python tools/bench_photon_cost.py --resolution 160 120 --passes 8
@@ -46,16 +47,17 @@ def main(argv=None):
             name, photon, camera, measured, cw["rays"] / (w * h), cw["lookups"] / (w * h), pw["rays"], pw["lookups"],
             modelled, modelled / measured), flush=True)
     best = None
-    for ray_cost in [x * 0.5 for x in range(1, 201)]:
-        for lookup_cost in [x * 0.1 for x in range(5, 60)]:
-            err = sum(math.log((cw["rays"] * ray_cost + cw["lookups"]) /
-                               (pw["rays"] * ray_cost + pw["lookups"] * lookup_cost) / (w * h) / m) ** 2
-                      for m, cw, pw in rows if m > 0 and pw["rays"] + pw["lookups"] > 0)
-            if best is None or err < best[2]:
-                best = (ray_cost, lookup_cost, err)
-    print("\nfit to the measured balances (core/workCount.h): RayCost %.1f, PhotonLookupCost %.1f (rms log error %.2f)"
-          % (best[0], best[1], math.sqrt(best[2] / len(rows))))
-
+    for ray_cost in range(10, 301, 10):
+        for lookup_factor in [x * 0.1 for x in range(10, 41)]:
+            for base in range(0, 101, 5):
+                err = sum(math.log((cw["rays"] * ray_cost + cw["lookups"]) /
+                                   (base + pw["rays"] * ray_cost + pw["lookups"] * lookup_factor) / (w * h) / m) ** 2
+                          for m, cw, pw in rows if m > 0)
+                if best is None or err < best[3]:
+                    best = (ray_cost, lookup_factor, base, err)
+    print("\nfit to the measured balances (core/workCount.h; lookups weighted by the media's lookup costs as they "
+          "stand): RayCost %.0f, PhotonLookupCost %.1f, PhotonBaseCost %.0f (rms log error %.2f)"
+          % (best[0], best[1], best[2], math.sqrt(best[3] / len(rows))))
 
 if __name__ == "__main__":
     main()

@@ -33,6 +33,7 @@ public:
     bool isEmissive() const override { return !c_.emission.isBlack() && a_ > 0; }
     double maxAlbedo() const override;
     double phasePeak() const override { return volphoton::phasePeak(c_.phase.get()); }
+    double lookupCost() const override { return work::ExponentialLookupCost; }
     std::string describe() const override;
 
     /// Relative density a e^{-b h} at p, with the exponent clamped so it stays finite.

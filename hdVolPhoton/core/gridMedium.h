@@ -40,6 +40,7 @@
 #include <utility>
 
 #include "core/medium.h"
+#include "core/workCount.h"
 #include "core/vdbFile.h"  // light: declares openvdb::GridBase only
 
 namespace volphoton {
@@ -105,6 +106,7 @@ public:
     bool isEmissive() const override;
     double maxAlbedo() const override;
     double phasePeak() const override;
+    double lookupCost() const override { return work::GridLookupCost; }
     std::string describe() const override;
 
     /// Largest density grid value within reach of the support, background included (after

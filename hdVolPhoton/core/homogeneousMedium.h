@@ -10,6 +10,7 @@
 #pragma once
 
 #include "core/medium.h"
+#include "core/workCount.h"
 
 namespace volphoton {
 
@@ -39,6 +40,7 @@ public:
     bool isEmissive() const override { return !c_.emission.isBlack(); }
     double maxAlbedo() const override;
     double phasePeak() const override { return volphoton::phasePeak(c_.phase.get()); }
+    double lookupCost() const override { return work::HomogeneousLookupCost; }
     std::string describe() const override;
 
 private:

@@ -113,6 +113,9 @@ public:
     virtual double maxAlbedo() const = 0;
     /// The largest phasePeak() of its phase functions (1: isotropic).
     virtual double phasePeak() const = 0;
+    /// What one properties() call costs, in work units (core/workCount.h): the automatic photon
+    /// count weighs the lookups of a camera pass and of a photon with it.
+    virtual double lookupCost() const = 0;
     virtual std::string describe() const = 0;
 };
 

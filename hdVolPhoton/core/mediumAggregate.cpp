@@ -9,11 +9,12 @@ namespace volphoton {
 bool MediumAggregate::add(const Medium* medium) {
     if (!medium || count_ == MaxMedia) return false;
     media_[count_++] = medium;
+    lookupCost_ += medium->lookupCost();
     return true;
 }
 
 MediumProperties MediumAggregate::properties(const Vec3& p) const {
-    ++work::lookups;
+    work::lookups += lookupCost_;
     MediumProperties sum;
     for (int i = 0; i < count_; ++i) {
         MediumProperties mp = media_[i]->properties(p);

@@ -26,11 +26,14 @@ public:
     bool isEmissive() const override;
     double maxAlbedo() const override;
     double phasePeak() const override;
+    /// Its media's lookup costs summed.
+    double lookupCost() const override { return lookupCost_; }
     std::string describe() const override;
 
 private:
     const Medium* media_[MaxMedia] = {};
     int count_ = 0;
+    double lookupCost_ = 0;
 };
 
 }  // namespace volphoton

@@ -1055,7 +1055,7 @@ private:
         // measured by the two pilots, not by a clock, so the count is the same on every machine.
         stats.photonWork = pilotWork * (1.0 / PilotPhotons);
         stats.cameraWork = cameraWork_;
-        double workPerPhoton = stats.photonWork.units(work::PhotonLookupCost), workPerCameraPass = cameraWork_.units();
+        double workPerPhoton = work::PhotonBaseCost + stats.photonWork.units(work::PhotonLookupCost), workPerCameraPass = cameraWork_.units();
         stats.photonWorkRatio = workPerCameraPass > 0 && workPerPhoton > 0 ? workPerCameraPass / workPerPhoton : 0.0;
         photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(stats.photonWorkRatio);
         if (cache_) {

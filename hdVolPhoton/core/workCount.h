@@ -9,21 +9,30 @@ namespace volphoton::work {
 
 /// Per-thread running counts. A task reads them before and after its own work on its own thread
 /// (snapshot()), so the difference is its work whatever else the thread did.
-inline thread_local uint64_t rays = 0;     ///< Scene::intersect calls (BVH traversals)
-inline thread_local uint64_t lookups = 0;  ///< MediumAggregate::properties calls (medium evaluations)
+inline thread_local uint64_t rays = 0;  ///< Scene::intersect calls (BVH traversals)
+/// MediumAggregate::properties calls (medium evaluations), each weighted by its media's
+/// Medium::lookupCost (a grid's trilinear lookup costs several homogeneous ones).
+inline thread_local double lookups = 0;
 
-/// Costs in units of one camera-path medium lookup (a march step or a shadow-ray step): a ray, and a
-/// photon's medium lookup (free flight: majorant traversal, null collisions, event sampling around
-/// it). Fitted to the six benchmark scenes' measured photon and camera costs at 80 x 60 (2-core VM):
-/// the modelled balance is 0.68x-1.29x the measured one (rms log error 0.19; RayCost alone, 27.5,
-/// left 0.68x-2.28x). `python tools/bench_photon_cost.py` prints both and refits.
-constexpr double RayCost = 28.0, PhotonLookupCost = 2.0;
+/// Costs in work units: a ray, a medium's lookup by kind (Medium::lookupCost), and per photon traced
+/// its fixed cost (emission sampling, its random stream, its record) and the factor on its lookups
+/// (free flight: majorant traversal, null collisions and event sampling around each). The units are
+/// relative: the three lookup costs are in proportion to the measured time of a camera lookup in each
+/// kind of medium (2-core VM, 80 x 60, 2026-12-05: the cube gives the homogeneous one, the atmosphere
+/// the exponential one, the VDB cloud, dense cloud and emissive smoke the grid's). RayCost,
+/// PhotonLookupCost and PhotonBaseCost are then the least-squares fit of
+/// `python tools/bench_photon_cost.py` to the measured balances of the six open-media benchmark
+/// scenes: modelled 0.85x-1.06x the measured (rms log error 0.08), where a ray at 28 unweighted
+/// lookups and no per-photon cost gave 0.62x-3.98x (0.54; fog + spot the 3.98x: its photons' fixed
+/// cost was not counted).
+constexpr double RayCost = 30.0, PhotonLookupCost = 2.0, PhotonBaseCost = 10.0;
+constexpr double HomogeneousLookupCost = 20.0, ExponentialLookupCost = 45.0, GridLookupCost = 130.0;
 
 /// Rays and lookups counted, or their difference between two snapshots.
 struct Count {
     double rays = 0, lookups = 0;
-    /// Work units, a lookup costing lookupCost (PhotonLookupCost for photons).
-    double units(double lookupCost = 1.0) const { return rays * RayCost + lookups * lookupCost; }
+    /// Work units, lookups weighted by lookupFactor (PhotonLookupCost for photons).
+    double units(double lookupFactor = 1.0) const { return rays * RayCost + lookups * lookupFactor; }
     Count& operator+=(const Count& o) {
         rays += o.rays;
         lookups += o.lookups;
@@ -32,7 +41,7 @@ struct Count {
     Count operator*(double f) const { return {rays * f, lookups * f}; }
 };
 using Snapshot = Count;
-inline Count snapshot() { return {double(rays), double(lookups)}; }
+inline Count snapshot() { return {double(rays), lookups}; }
 /// What this thread counted since `from`.
 inline Count since(const Count& from) { return {double(rays) - from.rays, double(lookups) - from.lookups}; }
 

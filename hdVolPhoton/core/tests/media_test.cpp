@@ -349,6 +349,7 @@ public:
     bool isEmissive() const override { return false; }
     double maxAlbedo() const override { return 0; }
     double phasePeak() const override { return 1; }
+    double lookupCost() const override { return 1; }
     std::string describe() const override { return "loose"; }
 };
 }  // namespace
