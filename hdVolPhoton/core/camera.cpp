@@ -40,4 +40,17 @@ Ray Camera::generateRay(double px, double py, double u1, double u2, double* tMin
     return ray;
 }
 
+bool Camera::project(const Vec3& p, double* px, double* py) const {
+    if (desc_.lensRadius > 0) return false;
+    std::optional<Affine> toCamera = desc_.cameraToWorld.inverse();
+    if (!toCamera) return false;
+    Vec3 q = toCamera->point(p);
+    if (!(q.z < 0) || !isFinite(q)) return false;
+    double half = desc_.projection == CameraDesc::Projection::Orthographic ? desc_.orthoWidth / 2 : desc_.tanHalfFovX * -q.z;
+    double sx = q.x / half, sy = q.y / half;  // generateRay's screen coordinates, inverted
+    *px = (sx + 1) * width_ / 2;
+    *py = (1 - sy * width_ / static_cast<double>(height_)) * height_ / 2;
+    return *px >= 0 && *px < width_ && *py >= 0 && *py < height_;
+}
+
 }  // namespace volphoton

@@ -36,6 +36,9 @@ public:
     /// Ray through image position (px, py) in pixels (0,0 top-left), lens sample (u1, u2).
     /// Returns the ray and its valid interval [tMin, tMax].
     Ray generateRay(double px, double py, double u1, double u2, double* tMin, double* tMax) const;
+    /// Where world point p images, in generateRay's pixel coordinates: set when p is in front of a
+    /// pinhole or orthographic camera and inside the image (a thin lens blurs a point's image: false).
+    bool project(const Vec3& p, double* px, double* py) const;
     Vec3 position() const { return desc_.cameraToWorld.point(Vec3()); }
     int width() const { return width_; }
     int height() const { return height_; }

@@ -250,6 +250,17 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     usesPhotons_ = photonMapper;
     stats_.integratorUsed = photonMapper ? (combined ? "combined" : "photonMap") : "pathTracer";
     integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache)) : makePathTracer(*scene_, settings_);
+    if (scene_->hasMedia()) {
+        Camera camera(scene_->desc().camera, settings_.width, settings_.height);
+        for (const LightPtr& light : scene_->lights()) {
+            std::optional<Vec3> c = light->equiangularCenter();
+            double px, py;
+            if (!c || !camera.project(*c, &px, &py)) continue;
+            size_t index = static_cast<size_t>(py) * settings_.width + static_cast<size_t>(px);
+            if (!lightPixel(static_cast<int>(px), static_cast<int>(py)))
+                lightPixels_.insert(std::lower_bound(lightPixels_.begin(), lightPixels_.end(), index), {index, {px, py}});
+        }
+    }
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
     if (scene_->hasMedia() && !scene_->hasEmissiveMedia()) stats_.passesSkipped.push_back("volume emission: no medium emits");
 }
@@ -269,11 +280,30 @@ std::unique_ptr<tbb::global_control> limitThreads(const RenderSettings& settings
 /// such a sample must never reach a film.
 /// guides: also the denoiser guides of the same camera ray, from their own stream (guideRng), so
 /// that the beauty is the same with or without them.
+/// around: the pixel images a point-like light (Renderer::lightPixels_): its position comes from
+/// samplePixelAroundPoint, and the radiance (and alpha) carry that sample's weight.
 bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int y, Rng& rng, PathRadiance* L,
-                  Rng* guideRng = nullptr) {
+                  Rng* guideRng = nullptr, const ImagePoint* around = nullptr) {
     double tMin, tMax;
-    Ray ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
+    Ray ray;
+    double weight = 1;
+    if (around) {
+        double u0 = rng.uniform(), u1 = rng.uniform();
+        PixelPosition pos = samplePixelAroundPoint(x, y, *around, u0, u1);
+        double l0 = rng.uniform(), l1 = rng.uniform();
+        ray = camera.generateRay(pos.x, pos.y, l0, l1, &tMin, &tMax);
+        weight = pos.weight;
+    } else {
+        ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
+    }
     *L = integrator.Li(ray, tMin, tMax, rng);
+    if (weight != 1) {
+        L->single = L->single * weight;
+        L->multiple = L->multiple * weight;
+        L->emission = L->emission * weight;
+        L->surface = L->surface * weight;
+        L->alpha *= weight;
+    }
     if (guideRng) integrator.firstVertexGuides(ray, tMin, tMax, *guideRng, &L->albedo, &L->normal);
     if (L->beauty().isFinite() && L->beauty().minValue() >= 0) return true;
     *L = PathRadiance();
@@ -281,6 +311,12 @@ bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int
 }
 
 }  // namespace
+
+const ImagePoint* Renderer::lightPixel(int x, int y) const {
+    size_t index = static_cast<size_t>(y) * settings_.width + x;
+    auto it = std::lower_bound(lightPixels_.begin(), lightPixels_.end(), index);
+    return it != lightPixels_.end() && it->index == index ? &it->light : nullptr;
+}
 
 work::Count Renderer::cameraPilotWork() const {
     const int w = settings_.width, h = settings_.height;
@@ -322,24 +358,28 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                 for (int y = ty * tile; y < std::min(settings_.height, (ty + 1) * tile); ++y)
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
                         if (!active_[static_cast<size_t>(y) * settings_.width + x]) continue;
-                        // The pixel's own sample index (= pass_ unless adaptive sampling skipped it).
-                        uint32_t sample = film_.samples(x, y);
-                        Rng rng(hashKeys(x, y, settings_.seed), sample);
-                        rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
-                        PathRadiance L;
-                        Rng guideRng(hashKeys(x, y, settings_.seed, 0x6775696465ULL), sample);  // "guide"
-                        if (!cameraSample(*integrator_, camera, x, y, rng, &L, settings_.guideAovs ? &guideRng : nullptr)) {
-                            // never on the film: dropped, and reported
-                            static std::atomic<int> reported{0};
-                            if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
+                        const ImagePoint* light = lightPixels_.empty() ? nullptr : lightPixel(x, y);
+                        for (int k = 0, n = light ? LightPixelSamples : 1; k < n; ++k) {
+                            // The pixel's own sample index (= pass_ unless adaptive sampling skipped it).
+                            uint32_t sample = film_.samples(x, y);
+                            Rng rng(hashKeys(x, y, settings_.seed), sample);
+                            rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
+                            PathRadiance L;
+                            Rng guideRng(hashKeys(x, y, settings_.seed, 0x6775696465ULL), sample);  // "guide"
+                            if (!cameraSample(*integrator_, camera, x, y, rng, &L, settings_.guideAovs ? &guideRng : nullptr, light)) {
+                                // never on the film: dropped, and reported
+                                static std::atomic<int> reported{0};
+                                if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
+                            }
+                            film_.add(x, y, L);
                         }
-                        film_.add(x, y, L);
                         if (pass_ == 0) film_.setIds(x, y, pixelIds(camera, x, y));
                     }
             }
     });
     if (!cancelled) {
         stats_.cameraSamples += stats_.activePixels;
+        for (const LightPixel& p : lightPixels_) stats_.cameraSamples += active_[p.index] ? LightPixelSamples - 1 : 0;
         ++pass_;
         ++stats_.passes;
         updateAdaptive();  // timed with the pass: the time limit counts it

@@ -110,6 +110,7 @@
 #include "core/film.h"
 #include "core/scene.h"
 #include "core/transmittance.h"
+#include "core/sampling.h"
 #include "core/workCount.h"
 
 namespace volphoton {
@@ -232,7 +233,8 @@ inline int autoPhotonsPerPass(double balance) {
 /// Progressive rendering of a Scene into a Film: each pass adds one sample per pixel (after a photon
 /// pass for the photon-map integrator). Tiles run in parallel with TBB; the cancel callback is polled
 /// per tile and per photon batch. Same settings -> bit-identical film. Pass 0 also fills the film's id
-/// images from each pixel's centre ray (pixelIds()).
+/// images from each pixel's centre ray (pixelIds()). The pixel that images a point or spot light
+/// in a medium samples positions around that image (lightPixels_).
 ///
 /// Adaptive sampling (settings.noiseTarget > 0), the same for every front end: every pixel gets
 /// samplesPerPixel passes; after each later pass a pixel keeps sampling only while its estimated
@@ -291,6 +293,22 @@ private:
     std::vector<uint8_t> active_;
     double lastPassSeconds_ = 0;
     bool usesPhotons_ = false;  ///< the photon-map integrator renders (the scene has media)
+    /// Pixels whose footprint holds the image of a point-like light (Light::equiangularCenter) in a
+    /// scene with media, sorted by pixel index: their camera samples take positions from
+    /// samplePixelAroundPoint (sampling.h), whose variance stays bounded where the medium's scattered
+    /// light grows as 1/h towards the light. Empty without media, lights in view or with a thin lens.
+    struct LightPixel {
+        size_t index;
+        ImagePoint light;  ///< the light's image
+        bool operator<(size_t i) const { return index < i; }
+    };
+    std::vector<LightPixel> lightPixels_;
+    /// Camera samples a light pixel takes per pass (one for every other pixel): its estimate stays
+    /// the noisiest of the image even with bounded weights (a spot's cone lights a wedge around its
+    /// image), and it is one pixel, so its samples cost nothing against the pass.
+    static constexpr int LightPixelSamples = 16;
+    /// The light image in pixel (x, y)'s footprint, or null.
+    const ImagePoint* lightPixel(int x, int y) const;
     /// The work (core/workCount.h) of one camera pass, from 256 deterministic camera samples.
     work::Count cameraPilotWork() const;
     /// After a pass: the active mask and the error statistics from the film.

@@ -351,6 +351,73 @@ TEST(IntegratorSingleScattering, AirlightClosedForm) {
     }
 }
 
+TEST(IntegratorSingleScattering, APixelImagingAPointLightMatchesQuadrature) {
+    // A point light (I = 1) in unbounded fog (sigma_t = 0.1, sigma_s = 0.08, isotropic) seen by a 9x9
+    // camera: the pixel holding the light's image averages single scattering that grows as 1/h
+    // towards the light. Expected: quadrature over the pixel in polar coordinates around the light's
+    // image (r dr dphi cancels the 1/h) of the equiangular form of the airlight integral,
+    // sigma_s / (4 pi h) int exp(-sigma_t (t + d)) dtheta. Both integrators within 4 standard errors
+    // of 16 seeds, and that error below 0.4% of the value. Measured: 0.12% (path tracer) and 0.06%
+    // (photon map); with uniform pixel positions and one sample a pass (before Renderer::lightPixels_)
+    // 1.1% and 0.9%, the means 2.3 and 2.5 errors low (the estimate's variance diverges as samples
+    // come near the light, so most runs miss the rare large ones).
+    const double sigmaT = 0.1, sigmaS = 0.08, eyeZ = 5, tanHalf = 0.05;
+    const int size = 9;
+    const Vec3 light(0.004, -0.003, 0);
+    SceneDesc d;
+    d.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(sigmaS / sigmaT), Spectrum(0.0), makeIsotropicPhase())));
+    d.unboundedMedia.push_back(0);
+    d.lights.push_back(makeSphereLight(light, 0.0, Spectrum(1.0)));
+    d.camera = lookAt(Vec3(0, 0, eyeZ), Vec3(0, 0, 0), tanHalf);
+    // The light's image from the camera's geometry (x right, y up, half-width eyeZ tanHalf at z = 0).
+    const double cx = (light.x / (eyeZ * tanHalf) + 1) * size / 2, cy = (1 - light.y / (eyeZ * tanHalf)) * size / 2;
+    const int px = static_cast<int>(cx), py = static_cast<int>(cy);
+    ASSERT_EQ(px, 4);
+    ASSERT_EQ(py, 4);
+    Camera camera(d.camera, size, size);
+    auto radiance = [&](double x, double y) {
+        double tMin, tMax;
+        Ray ray = camera.generateRay(x, y, 0.5, 0.5, &tMin, &tMax);
+        Vec3 toLight = light - ray.o;
+        double t0 = dot(toLight, ray.d), h = length(toLight - ray.d * t0);
+        double a = std::atan2(-t0, h), b = Pi / 2, sum = 0;
+        const int n = 400;
+        for (int i = 0; i < n; ++i) {
+            double theta = a + (i + 0.5) * (b - a) / n, t = t0 + h * std::tan(theta);
+            sum += std::exp(-sigmaT * (t + h / std::cos(theta)));
+        }
+        return sigmaS * Inv4Pi / h * sum * (b - a) / n;
+    };
+    double expected = 0;
+    const int nPhi = 360, nR = 100;
+    for (int i = 0; i < nPhi; ++i) {
+        double phi = (i + 0.5) * 2 * Pi / nPhi, ux = std::cos(phi), uy = std::sin(phi);
+        double rMax = std::min(ux > 0 ? (px + 1 - cx) / ux : ux < 0 ? (px - cx) / ux : Infinity,
+                               uy > 0 ? (py + 1 - cy) / uy : uy < 0 ? (py - cy) / uy : Infinity);
+        for (int j = 0; j < nR; ++j) {
+            double r = (j + 0.5) * rMax / nR;
+            expected += radiance(cx + r * ux, cy + r * uy) * r * (rMax / nR) * (2 * Pi / nPhi);
+        }
+    }
+    auto scene = std::make_shared<Scene>(d);
+    for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
+        std::vector<double> xs;
+        for (int seed = 0; seed < test::RenderSeeds; ++seed) {
+            RenderSettings s = smallSettings(integrator, 64, seed);
+            s.width = s.height = size;
+            s.multipleScattering = false;
+            Renderer r(scene, s);
+            r.render();
+            xs.push_back(r.film().resolveRgb(Film::Single)[3 * (py * size + px)]);
+        }
+        auto me = meanAndError(xs);
+        const char* name = integrator == RenderSettings::Integrator::PathTracer ? "path tracer" : "photon map";
+        EXPECT_NEAR(me.mean, expected, 4 * me.stderr_) << name << ", quadrature " << expected;
+        EXPECT_LT(me.stderr_, 0.004 * expected) << name;
+    }
+}
+
 namespace {
 /// Chandrasekhar's H-function for isotropic scattering by iteration of
 /// 1/H(mu) = sqrt(1 - w) + (w/2) int_0^1 mu' H(mu') / (mu + mu') dmu' (Gauss-Legendre nodes), and the

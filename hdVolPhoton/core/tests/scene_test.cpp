@@ -582,3 +582,29 @@ TEST(SceneLights, EveryLightOrOnePickedAtSurfacesGivesTheExactDirectIrradiance) 
         EXPECT_LT(4 * m.stderr_, 0.01 * expected) << extraLights << " extra lights, mean " << m.mean;  // resolves a 1% bias
     }
 }
+
+TEST(Camera, ProjectInvertsGenerateRay) {
+    // project() gives back the image position a ray was generated through (perspective and
+    // orthographic, a non-square image, a scaled and rotated camera), and refuses points behind the
+    // camera, outside the image, or seen through a thin lens.
+    for (auto projection : {CameraDesc::Projection::Perspective, CameraDesc::Projection::Orthographic}) {
+        CameraDesc d = test::lookAt(Vec3(1, 2, 3), Vec3(0.2, -0.1, 0.4), 0.7);
+        for (int r = 0; r < 3; ++r) d.cameraToWorld.m[r][0] *= 2;  // a scaled camera frame
+        d.projection = projection;
+        d.orthoWidth = 3;
+        Camera camera(d, 64, 40);
+        for (auto [x, y] : {std::pair{0.25, 0.5}, {31.7, 12.2}, {63.9, 39.9}, {10.0, 38.0}}) {
+            double tMin, tMax, px = -1, py = -1;
+            Ray ray = camera.generateRay(x, y, 0.5, 0.5, &tMin, &tMax);
+            ASSERT_TRUE(camera.project(ray.at(4.0), &px, &py)) << x << ", " << y;
+            EXPECT_NEAR(px, x, 1e-9);
+            EXPECT_NEAR(py, y, 1e-9);
+            EXPECT_FALSE(camera.project(ray.at(-4.0), &px, &py)) << "behind the camera";
+        }
+        double tMin, tMax, px, py;
+        Ray outside = camera.generateRay(-3, 20, 0.5, 0.5, &tMin, &tMax);
+        EXPECT_FALSE(camera.project(outside.at(4.0), &px, &py));
+        d.lensRadius = 0.1;
+        EXPECT_FALSE(Camera(d, 64, 40).project(camera.generateRay(5, 5, 0.5, 0.5, &tMin, &tMax).at(4.0), &px, &py));
+    }
+}
