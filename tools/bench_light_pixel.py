@@ -51,7 +51,8 @@ def main():
             np.savez(a.save, batches=batches)
     ref = batches.mean(0)
     ref_var = (batches.var(0, ddof=1) / len(batches)).mean()
-    print("%s: reference %g s, its noise RMSE %.6f (removed below); %s" % (a.scene, a.reference, np.sqrt(ref_var), _core.__file__))
+    print("%s: reference %s, its noise RMSE %.6f (removed below); %s" % (
+        a.scene, a.load or "%g s" % a.reference, np.sqrt(ref_var), _core.__file__))
     for label, integrator, beams in (("pathTracer", "PathTracer", False), ("photonMap points", "PhotonMap", False),
                                      ("photonMap beams", "PhotonMap", True)):
         mse, worst = [], []
