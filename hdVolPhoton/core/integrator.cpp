@@ -296,12 +296,10 @@ bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int
     } else {
         ray = camera.generateRay(x + rng.uniform(), y + rng.uniform(), rng.uniform(), rng.uniform(), &tMin, &tMax);
     }
-    *L = integrator.Li(ray, tMin, tMax, rng);
+    // weight 0: a polar position outside the pixel, a sample of value 0 (its guides still count).
+    *L = weight > 0 ? integrator.Li(ray, tMin, tMax, rng) : PathRadiance();
     if (weight != 1) {
-        L->single = L->single * weight;
-        L->multiple = L->multiple * weight;
-        L->emission = L->emission * weight;
-        L->surface = L->surface * weight;
+        for (Spectrum* part : {&L->single, &L->multiple, &L->emission, &L->surface}) *part *= weight;
         L->alpha *= weight;
     }
     if (guideRng) integrator.firstVertexGuides(ray, tMin, tMax, *guideRng, &L->albedo, &L->normal);
