@@ -257,8 +257,8 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
             double px, py;
             if (!c || !camera.project(*c, &px, &py)) continue;
             size_t index = static_cast<size_t>(py) * settings_.width + static_cast<size_t>(px);
-            if (!lightPixel(static_cast<int>(px), static_cast<int>(py)))
-                lightPixels_.insert(std::lower_bound(lightPixels_.begin(), lightPixels_.end(), index), {index, {px, py}});
+            auto at = std::lower_bound(lightPixels_.begin(), lightPixels_.end(), index);
+            if (at == lightPixels_.end() || at->index != index) lightPixels_.insert(at, {index, {px, py}});
         }
     }
     if (!scene_->hasMedia()) stats_.passesSkipped.push_back("volumes: the scene has no media");
@@ -311,6 +311,7 @@ bool cameraSample(const Integrator& integrator, const Camera& camera, int x, int
 }  // namespace
 
 const ImagePoint* Renderer::lightPixel(int x, int y) const {
+    if (lightPixels_.empty()) return nullptr;  // most scenes: nothing to look up
     size_t index = static_cast<size_t>(y) * settings_.width + x;
     auto it = std::lower_bound(lightPixels_.begin(), lightPixels_.end(), index);
     return it != lightPixels_.end() && it->index == index ? &it->light : nullptr;
@@ -356,7 +357,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                 for (int y = ty * tile; y < std::min(settings_.height, (ty + 1) * tile); ++y)
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
                         if (!active_[static_cast<size_t>(y) * settings_.width + x]) continue;
-                        const ImagePoint* light = lightPixels_.empty() ? nullptr : lightPixel(x, y);
+                        const ImagePoint* light = lightPixel(x, y);
                         for (int k = 0, n = light ? LightPixelSamples : 1; k < n; ++k) {
                             // The pixel's own sample index (= pass_ unless adaptive sampling skipped it).
                             uint32_t sample = film_.samples(x, y);
