@@ -2,7 +2,7 @@
 """Equal-time RMSE where a point-like light is in view (issue 15, scene 4): a path-traced reference of
 --reference seconds in 8 batches (its own noise estimated from them and removed from every MSE), then
 --seeds renders of --seconds each with the path tracer, the photon map with points and with beams
-(80x60, the scene's settings, 2 threads), and the share of each render's squared error in its worst
+(80x60 unless --resolution, the scene's settings, 2 threads), and the share of each render's squared error in its worst
 pixel (the light's pixel held most of it before Renderer::lightPixels_).
 
     python tools/bench_light_pixel.py                        # fog + spot, 320 s reference, ~7 min
@@ -17,7 +17,7 @@ import numpy as np
 from bench_load import load_bench_scene
 from volphoton import _core
 
-SIZE = (80, 60)
+SIZE = [80, 60]
 
 
 def render(scene, rs, integrator, seed, seconds, beams=False):
@@ -37,10 +37,12 @@ def main():
     ap.add_argument("--scene", default="fog_spotlight")
     ap.add_argument("--seconds", type=float, default=4.0)
     ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--resolution", nargs=2, type=int, default=list(SIZE), metavar=("W", "H"))
     ap.add_argument("--reference", type=float, default=320.0, help="seconds of the path-traced reference")
     ap.add_argument("--save", help="write the reference's batches to this .npz")
     ap.add_argument("--load", help="read the reference's batches from this .npz instead of rendering it")
     a = ap.parse_args()
+    SIZE[:] = a.resolution
     rs, tr = load_bench_scene(a.scene, *SIZE)
     scene = _core.Scene(tr.desc)
     if a.load:

@@ -6,8 +6,8 @@
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, combined (the   |
 // |                     |        |            |              | path tracer with the photon map's multiple        |
 // |                     |        |            |              | scattering, combinedPhotonShare), or auto: one of |
-// |                     |        |            |              | pathTracer/combined per scene by a pilot          |
-// |                     |        |            |              | (chooseIntegrator)                                |
+// |                     |        |            |              | pathTracer, combined or photonMap with beams per  |
+// |                     |        |            |              | scene by a pilot (chooseIntegrator)               |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
 // |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
@@ -191,6 +191,8 @@ struct IntegratorChoice {
     std::string reason;
     /// Translucent objects in view and a delta light: the path tracer would miss that light inside.
     bool photonsOnly = false;
+    /// The photon map with photon beams (RenderSettings::photonBeams) for thin, point-lit open media.
+    bool photonBeams = false;
 };
 /// integrator = auto: a pilot of 32 x 24 camera rays through the image finds what the view is made of:
 /// translucent objects (closed dielectric meshes with a medium inside, which next-event estimation
@@ -198,8 +200,10 @@ struct IntegratorChoice {
 /// object in them: it takes photons inside translucent objects, where the photon map leads the path
 /// tracer at equal time (both subsurface benchmark scenes) and where a delta light's light arrives only
 /// as photons (photonsOnly), and the path tracer's paths elsewhere (on the ball behind a fog bank it
-/// leads both); the path tracer renders the rest (it leads on every open-media benchmark scene,
-/// tools/bench/README.md).
+/// leads both). Open media alone: the photon map with photon beams where they are optically thin (mean
+/// majorant optical depth below 1 along the pilot rays that cross them) and every light is point-like
+/// (point, spot, sphere: fog + spot, benchmark scene 4), the path tracer otherwise (it leads on the
+/// other open-media benchmark scenes, tools/bench/README.md).
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;

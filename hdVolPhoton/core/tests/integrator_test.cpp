@@ -844,6 +844,83 @@ TEST(IntegratorAuto, ThePilotPicksCombinedForTranslucentObjectsAndThePathTracerF
     EXPECT_EQ(r2.stats().integratorUsed, "pathTracer");
 }
 
+TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
+    // chooseIntegrator: a fog box 2 units across (sigma_t 0.2: optical depth 0.4 across) lit by a
+    // point light and a small sphere light -> the photon map with beams, and the Renderer renders
+    // exactly that (bit-identical to photonMap + photonBeams named). The same fog with a dome added,
+    // with a distant light instead, or ten times denser (optical depth 4) -> the path tracer. Media
+    // behind index-matched boundaries count as media in view.
+    using I = RenderSettings::Integrator;
+    auto fog = [](double sigmaT) {
+        SceneDesc d;
+        auto c = MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
+        d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
+        d.unboundedMedia.push_back(0);
+        d.lights.push_back(makeSphereLight(Vec3(0.3, 0.5, 0.2), 0.0, Spectrum(1.0)));
+        d.lights.push_back(makeSphereLight(Vec3(-0.4, 0.2, -0.3), 0.1, Spectrum(0.5)));
+        d.camera = lookAt(Vec3(0.2, 0.3, 3.5), Vec3(0, 0, 0), 0.3);
+        return d;
+    };
+    RenderSettings s = smallSettings(I::Auto, 2, 5);
+    auto choose = [&](const SceneDesc& d) { return chooseIntegrator(Scene(d), s); };
+    SceneDesc thin = fog(0.2);
+    IntegratorChoice c = choose(thin);
+    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_TRUE(c.photonBeams) << c.reason;
+    EXPECT_NE(c.reason.find("mean optical depth 0."), std::string::npos) << c.reason;  // at most 0.4 on every ray
+    EXPECT_NE(c.reason.find("photon beams lead the path tracer"), std::string::npos) << c.reason;
+
+    auto scene = std::make_shared<Scene>(thin);
+    Renderer autoRender(scene, s);
+    RenderSettings named = smallSettings(I::PhotonMap, 2, 5), points = named;
+    named.photonBeams = true;
+    Renderer beamRender(scene, named), pointRender(scene, points);
+    autoRender.render();
+    beamRender.render();
+    pointRender.render();
+    EXPECT_EQ(autoRender.stats().integratorUsed, "photonMap");
+    EXPECT_EQ(autoRender.film().resolveRgb(Film::Beauty), beamRender.film().resolveRgb(Film::Beauty));
+    EXPECT_NE(autoRender.film().resolveRgb(Film::Beauty), pointRender.film().resolveRgb(Film::Beauty));
+
+    SceneDesc domeToo = thin;
+    domeToo.lights.push_back(makeDomeLight(Spectrum(0.1)));
+    EXPECT_EQ(choose(domeToo).integrator, I::PathTracer) << choose(domeToo).reason;
+    SceneDesc sun = thin;
+    sun.lights = {makeDistantLight(normalize(Vec3(0.3, -1, 0.2)), 0.0, Spectrum(2.0))};
+    EXPECT_EQ(choose(sun).integrator, I::PathTracer) << choose(sun).reason;
+    c = choose(fog(2.0));
+    EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+    EXPECT_FALSE(c.photonBeams);
+    EXPECT_EQ(c.reason.find("mean optical depth 0."), std::string::npos) << c.reason;
+
+    // The same fog bounded by a mesh (an index-matched boundary, as a UsdGeom Cube with the medium
+    // API becomes): the pilot walks through the boundary and sees the same thin fog; a translucent
+    // box behind it (a dielectric with a medium inside) makes the choice combined.
+    SceneDesc bounded = thin;
+    bounded.unboundedMedia.clear();
+    MeshDesc boundary = test::boxMesh("fogBox", Vec3(-1, -1, -1), Vec3(1, 1, 1));
+    boundary.material.kind = SurfaceMaterial::Kind::Boundary;
+    boundary.interiorMedium = 0;
+    bounded.meshes.push_back(boundary);
+    bounded.instances.push_back({0, Affine()});
+    c = choose(bounded);
+    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_NE(c.reason.find("open media 100%"), std::string::npos) << c.reason;
+    SceneDesc behind = bounded;
+    behind.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(20.0, Spectrum(1.0), Spectrum(0.99), Spectrum(0.0), makeIsotropicPhase()),
+        Bounds3{Vec3(-0.3, -0.3, -2.0), Vec3(0.3, 0.3, -1.4)}));
+    MeshDesc marble = test::boxMesh("marble", Vec3(-0.3, -0.3, -2.0), Vec3(0.3, 0.3, -1.4));
+    marble.material.kind = SurfaceMaterial::Kind::Dielectric;
+    marble.material.ior = 1.3;
+    marble.interiorMedium = 1;
+    behind.meshes.push_back(marble);
+    behind.instances.push_back({1, Affine()});
+    c = choose(behind);
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+    EXPECT_EQ(c.reason.find("translucent objects cover 0%"), std::string::npos) << c.reason;
+}
+
 TEST(IntegratorAovs, BeautyIsTheSumOfTheSplit) {
     SceneDesc d = mediaOnlyScene();
     d.lights.push_back(makeDomeLight(Spectrum(0.2)));
