@@ -373,9 +373,9 @@ work::Count Renderer::cameraPilotWork() const {
 bool Renderer::renderPass(const CancelCallback& cancel) {
     auto start = std::chrono::steady_clock::now();
     auto threads = limitThreads(settings_);
-    // The photon map's automatic photon count weighs a camera pass's work (deterministic pilot, on
-    // this thread: work is counted per thread) against a photon's.
-    if (pass_ == 0 && usesPhotons_ && settings_.photonsPerPass == 0) integrator_->setCameraWork(cameraPilotWork());
+    // The photon map's automatic photon count weighs a camera pass's work (deterministic pilot, run
+    // by beginPass on this thread: work is counted per thread) against a photon's.
+    if (pass_ == 0 && usesPhotons_ && settings_.photonsPerPass == 0) integrator_->setCameraPilot([this] { return cameraPilotWork(); });
     if (!integrator_->beginPass(pass_, stats_, cancel)) {
         stats_.cancelled = true;
         return false;

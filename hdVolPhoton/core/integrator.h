@@ -38,9 +38,10 @@
 // |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
 // | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: as many |
-// |                     |        |            |              | as cost one camera pass (pilots count work, not   |
-// |                     |        |            |              | time), in [4096, 1e6] (autoPhotonsPerPass), or the|
-// |                     |        |            |              | count of the maps a PhotonCache keeps             |
+// |                     |        |            |              | as cost one camera pass, tracing and gathers      |
+// |                     |        |            |              | (pilots count work, not time), in [4096, 1e6]     |
+// |                     |        |            |              | (autoPhotonsPerPass), or the count of the maps a  |
+// |                     |        |            |              | PhotonCache keeps                                 |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the media's diameter, Scene::mediaRadius, else of |
 // |                     |        |            |              | the scene's)                                      |
@@ -163,8 +164,11 @@ struct RenderStats {
     double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
     double photonRadius = 0;
     int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic), 0 without photons
-    double photonWorkRatio = 0;      ///< photonMap: photons costing as much as a camera pass (pilots; 0: not measured)
-    work::Count cameraWork, photonWork;  ///< photonMap pilots: rays and lookups of a camera pass, of a photon
+    /// photonMap: photons whose tracing and gathers cost as much as a camera pass (pilots; 0: not measured)
+    double photonWorkRatio = 0;
+    /// photonMap pilots: rays and lookups of a camera pass without photons, of tracing a photon, and
+    /// the gathers a stored photon adds to a camera pass
+    work::Count cameraWork, photonWork, gatherWork;
     int photonPassesReused = 0;      ///< photon passes taken from a PhotonCache instead of traced
     uint64_t photonsReused = 0;      ///< photons in those passes' maps
     double multipleToSingleRatio = -1;  ///< pilot estimate (photonMap), -1 if not measured
@@ -212,11 +216,16 @@ using CancelCallback = std::function<bool()>;
 class Integrator;
 class PhotonCache;
 
-/// The automatic photon count (photonsPerPass = 0) from `balance`, the photons whose tracing costs as
-/// much as one camera pass (RenderStats::photonWorkRatio: work units, core/workCount.h, of a camera
-/// pass over those of a photon, both counted by deterministic pilots, so the count is the same on
-/// every machine): PhotonShare x balance, at least one tracing batch (MinAutoPhotons) and at most
-/// MaxAutoPhotons (about 100 MB of photon map).
+/// The automatic photon count (photonsPerPass = 0) from `balance`, the photons whose tracing and
+/// gathers cost as much as one camera pass without photons (RenderStats::photonWorkRatio: work units,
+/// core/workCount.h, of a camera pass over those of a photon, both counted by deterministic pilots, so
+/// the count is the same on every machine; a photon's gathers are what a stored photon adds to the
+/// camera pilot): PhotonShare x balance, at least one tracing batch (MinAutoPhotons) and at most
+/// MaxAutoPhotons (about 100 MB of photon map). With gathers the cost of a pass is C + (c + g)P, so
+/// the argument below holds with c + g for c; as g grows with the pixels, the count stops growing
+/// with them once gathers dominate (fog + spot's beams at 320 x 240: 48k a pass, where tracing alone
+/// gave 594k whose gathers took 6x the rest of the camera pass; equal-time RMSE 0.30x; the README,
+/// "Photon maps: how many photons", has the figures).
 /// Why equal cost: the time to a given noise with P photons a pass is proportional to
 /// (a/P + b)(C + cP) (a/P: the photon map's variance, b: the camera side's, C and cP the two passes'
 /// costs), least at P = sqrt(aC/(bc)) = balance x sqrt(r), r = a/(b balance) the photons' share of

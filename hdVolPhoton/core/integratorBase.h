@@ -3,6 +3,8 @@
 // scattering and the camera path's whole surface vertex). Internal to the core.
 #pragma once
 
+#include <functional>
+
 #include "core/functionRef.h"
 #include "core/integrator.h"
 #include "core/rng.h"
@@ -130,9 +132,11 @@ public:
         return true;
     }
     virtual PathRadiance Li(const Ray& ray, double tMin, double tMax, Rng& rng) const = 0;
-    /// Before pass 0: the work units (workCount.h) one camera pass is expected to take, from a pilot of
-    /// camera samples (Renderer). The photon map sizes its automatic photon count from it.
-    virtual void setCameraWork(const work::Count& perPass) { (void)perPass; }
+    /// Before pass 0: a pilot of camera samples (Renderer::cameraPilotWork) that counts the work
+    /// (workCount.h) one camera pass takes with the integrator as it stands when called, on the calling
+    /// thread. The photon map sizes its automatic photon count from it: once without photons, once with
+    /// its pilot photons' maps (what a stored photon adds to a camera pass: its gathers).
+    virtual void setCameraPilot(std::function<work::Count()> pilot) { (void)pilot; }
     /// The denoiser guides of a camera ray (integrator.h, "AOVs"): *albedo and *normal at its first
     /// non-specular vertex (through boundaries and smooth dielectrics); a medium collision is sampled
     /// with the free-flight routine (a real collision accepted with probability average sigma_t /

@@ -1,6 +1,7 @@
 #include "core/photonBeams.h"
 
 #include "core/photonMap.h"
+#include "core/workCount.h"
 
 #include <algorithm>
 #include <cmath>
@@ -36,6 +37,7 @@ void beamBounds(const RTCBoundsFunctionArguments* args) {
 /// Closest approach of the query line and the beam line; reports, never accepts (traversal goes on).
 void beamIntersect(const RTCIntersectFunctionNArguments* args) {
     if (!args->valid[0]) return;
+    ++work::gathers;
     auto* q = reinterpret_cast<BeamQuery*>(args->context);
     const PhotonBeam& b = (*q->beams)[args->primID];
     const Ray& ray = *q->ray;

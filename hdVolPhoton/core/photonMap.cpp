@@ -1,5 +1,7 @@
 #include "core/photonMap.h"
 
+#include "core/workCount.h"
+
 #include <algorithm>
 
 namespace volphoton {
@@ -19,6 +21,7 @@ void gatherFilter(const RTCFilterFunctionNArguments* args) {
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         args->valid[i] = 0;  // never accept: keep traversing to find every disc along the ray
+        ++work::gathers;
         unsigned prim = RTCHitN_primID(args->hit, args->N, i);
         const Photon& ph = (*ctx->photons)[prim];
         Vec3 c(ph.p[0], ph.p[1], ph.p[2]);

@@ -173,17 +173,7 @@ public:
         PhotonRecords records;
         PhotonCache::Pass traced;
         if (!tracePhotons(pass, photonsPerPass_, &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
-        // Beams in the regions that take them (beamsIn), points elsewhere: each region's gathers read one.
-        map_ = nullptr;
-        beams_ = nullptr;
-        if (!records.beams.empty()) {
-            for (const PhotonBeam& b : records.beams) traced.radiusCapped += b.radius < rBeams;
-            traced.beams = beams_ = std::make_shared<const PhotonBeamMap>(std::move(records.beams), rBeams);
-        }
-        if (!records.photons.empty() || !beams_) {
-            traced.radiusCapped += noteNarrowKernels(records.photons, r);
-            traced.map = map_ = std::make_shared<const PhotonMap>(std::move(records.photons), r);
-        }
+        buildMaps(std::move(records), r, rBeams, &traced);
         stats.photonsTraced += traced.traced;
         stats.photonsThinned += traced.thinned;
         stats.photonsRadiusCapped += traced.radiusCapped;
@@ -193,7 +183,7 @@ public:
         return true;
     }
 
-    void setCameraWork(const work::Count& perPass) override { cameraWork_ = perPass; }
+    void setCameraPilot(std::function<work::Count()> pilot) override { cameraPilot_ = std::move(pilot); }
 
     /// The beam radius of pass `pass` (photonBeams): the 1D kernel's schedule r_{i+1} = r_i (i + alpha)/(i + 1)
     /// (Jarosz et al. 2011, "Progressive photon beams", eq. 21), counted in 1e5 photons as passRadius.
@@ -706,6 +696,22 @@ private:
         }
     };
 
+    /// The gathers' maps (map_, beams_) from a pass's records: beams in the regions that take them
+    /// (beamsIn), points elsewhere, so each region's gathers read one. Counts capped radii into *traced
+    /// and keeps the maps there.
+    void buildMaps(PhotonRecords&& records, double r, double rBeams, PhotonCache::Pass* traced) {
+        map_ = nullptr;
+        beams_ = nullptr;
+        if (!records.beams.empty()) {
+            for (const PhotonBeam& b : records.beams) traced->radiusCapped += b.radius < rBeams;
+            traced->beams = beams_ = std::make_shared<const PhotonBeamMap>(std::move(records.beams), rBeams);
+        }
+        if (!records.photons.empty() || !beams_) {
+            traced->radiusCapped += noteNarrowKernels(records.photons, r);
+            traced->map = map_ = std::make_shared<const PhotonMap>(std::move(records.photons), r);
+        }
+    }
+
     /// Photon tracing; fills photons (stored events) and, for the pilot, the energy at first events
     /// (index 0) and at stored events (index 1), and into workDone the work counted (workCount.h). Batches run in groups, appended in batch order; with
     /// `thinned`, whenever the photons kept pass twice the memory budget they are thinned to it
@@ -997,6 +1003,9 @@ private:
     }
 
     void decidePasses(RenderStats& stats) {
+        // A camera pass's own work (the automatic photon count), counted while nothing is decided:
+        // share() then gives the combined integrator's short camera paths.
+        if (cameraPilot_) cameraWork_ = cameraPilot_();
         passesDecided_ = true;
         stats.passesRun.push_back("camera");
         if (!scene_.hasMedia()) {
@@ -1055,7 +1064,21 @@ private:
         // measured by the two pilots, not by a clock, so the count is the same on every machine.
         stats.photonWork = pilotWork * (1.0 / PilotPhotons);
         stats.cameraWork = cameraWork_;
-        double workPerPhoton = work::PhotonBaseCost + stats.photonWork.units(work::PhotonLookupCost), workPerCameraPass = cameraWork_.units();
+        if (cameraPilot_ && settings_.photonsPerPass == 0) {
+            // Each stored photon or beam adds to every camera pass's gathers (candidates tested, their
+            // lookups): the camera pilot again, with maps of the pilot's records at pass 0's radii.
+            // Beams are long, so their gathers can cost more than their tracing (fog + spot at 320 x 240).
+            PhotonRecords copy = pilot;  // the pilot's own records key the cache
+            PhotonCache::Pass unused;
+            buildMaps(std::move(copy), passRadius(0), passBeamRadius(0), &unused);
+            work::Count gather = cameraPilot_() - cameraWork_;
+            map_ = nullptr;
+            beams_ = nullptr;
+            stats.gatherWork = work::Count{std::max(0.0, gather.rays), std::max(0.0, gather.lookups), std::max(0.0, gather.gathers)} *
+                               (1.0 / PilotPhotons);
+        }
+        double workPerPhoton = work::PhotonBaseCost + stats.photonWork.units(work::PhotonLookupCost) + stats.gatherWork.units();
+        double workPerCameraPass = cameraWork_.units();
         stats.photonWorkRatio = workPerCameraPass > 0 && workPerPhoton > 0 ? workPerCameraPass / workPerPhoton : 0.0;
         photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(stats.photonWorkRatio);
         if (cache_) {
@@ -1114,7 +1137,8 @@ private:
     std::shared_ptr<PhotonCache> cache_;
     int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
     std::unique_ptr<Integrator> cameraPaths_;  ///< integrator = combined: the path tracer's (PhotonEstimate)
-    work::Count cameraWork_;  ///< the work of a camera pass (Renderer's pilot, setCameraWork)
+    std::function<work::Count()> cameraPilot_;  ///< Renderer's camera-pass pilot (setCameraPilot)
+    work::Count cameraWork_;  ///< the work of a camera pass without photons (cameraPilot_)
 };
 
 }  // namespace

@@ -33,6 +33,8 @@ py::dict statsToDict(const RenderStats& s) {
     d["photon_work_ratio"] = s.photonWorkRatio;
     d["camera_pass_work"] = py::dict(py::arg("rays") = s.cameraWork.rays, py::arg("lookups") = s.cameraWork.lookups);
     d["photon_work"] = py::dict(py::arg("rays") = s.photonWork.rays, py::arg("lookups") = s.photonWork.lookups);
+    d["gather_work"] = py::dict(py::arg("rays") = s.gatherWork.rays, py::arg("lookups") = s.gatherWork.lookups,
+                                py::arg("gathers") = s.gatherWork.gathers);
     d["photon_passes_reused"] = s.photonPassesReused;
     d["photons_reused"] = s.photonsReused;
     d["multiple_to_single_ratio"] = s.multipleToSingleRatio;

@@ -3,6 +3,7 @@
 
 #include "core/homogeneousMedium.h"
 #include "core/photonCache.h"
+#include "core/workCount.h"
 #include "tests/renderTestUtil.h"
 
 namespace volphoton {
@@ -161,14 +162,49 @@ TEST(PhotonCount, AutomaticCountBalancesTheCameraPassDeterministically) {
         EXPECT_EQ(st->photonsTraced, static_cast<uint64_t>(st->photonsPerPass));
     }
     // A camera pass is 16x the work at 16x the pixels (the pilot's 256 samples spread over the image
-    // see the same scene; 20% for their different pixels).
-    EXPECT_NEAR(large.photonWorkRatio / small.photonWorkRatio, 16.0, 16 * 0.2);
+    // see the same scene; 20% for their different pixels), and so is a stored photon's share of it
+    // (its gathers: 16x the camera rays pass it).
+    EXPECT_NEAR(large.cameraWork.units() / small.cameraWork.units(), 16.0, 16 * 0.2);
+    EXPECT_GT(small.gatherWork.gathers, 0);
+    EXPECT_NEAR(large.gatherWork.units() / small.gatherWork.units(), 16.0, 16 * 0.2);
+    // The ratio: a camera pass's work over a photon's, tracing and gathers.
+    for (const RenderStats* st : {&small, &large})
+        EXPECT_DOUBLE_EQ(st->photonWorkRatio, st->cameraWork.units() / (work::PhotonBaseCost + st->photonWork.units(work::PhotonLookupCost) +
+                                                                        st->gatherWork.units()));
     // Counted work, not time: the same on any machine and thread count.
     EXPECT_EQ(oneThread.photonWorkRatio, large.photonWorkRatio);
     EXPECT_EQ(oneThread.photonsPerPass, large.photonsPerPass);
     // An explicit count is used as given, and the path tracer runs no pilot.
     s.photonsPerPass = 3000;
     EXPECT_EQ(run(40, 30, 0).photonsPerPass, 3000);
+}
+
+TEST(PhotonCount, GathersBoundTheCountAsTheImageGrows) {
+    // Beams in thin fog (benchmark scene 4's case): a stored beam is tested by many camera rays, so
+    // at 16x the pixels its gathers cost 16x too and the count grows far less than the camera pass.
+    // Counting only the tracing made it grow 16x (fog + spot at 320 x 240: 594k beams a pass whose
+    // gathers took 6x the rest of the camera pass; tools/bench_photon_cost.py).
+    SceneDesc d = fogScene(Vec3(1.5, 0.5, 0.5));
+    d.media[0] = std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(0.3, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3)),
+        Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)});
+    RenderSettings s = pmSettings(1);
+    s.photonsPerPass = 0;
+    s.photonBeams = true;
+    auto run = [&](int w, int h) {
+        s.width = w;
+        s.height = h;
+        return rendered(d, s)->stats();
+    };
+    RenderStats small = run(40, 30), large = run(160, 120);
+    EXPECT_GT(small.gatherWork.gathers, 0);
+    // The gathers, per beam and camera pass, cost more than the tracing at the larger size.
+    double tracing = work::PhotonBaseCost + large.photonWork.units(work::PhotonLookupCost);
+    EXPECT_GT(large.gatherWork.units(), tracing);
+    EXPECT_NEAR(large.cameraWork.units() / small.cameraWork.units(), 16.0, 16 * 0.2);
+    // 1.19x here (21k -> 25k beams); 16x without the gathers (130k -> 1e6, the cap).
+    EXPECT_LT(large.photonWorkRatio / small.photonWorkRatio, 4.0);
+    EXPECT_LT(double(large.photonsPerPass) / small.photonsPerPass, 4.0);
 }
 
 TEST(PhotonCount, AResizedImageKeepsTheCachedAutomaticCount) {
