@@ -220,8 +220,9 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // Thin open media lit only by point-like lights: photon beams (beam x beam, photonBeams.h) inform
     // every camera ray that passes near a photon's flight, where the path tracer's collisions are few
     // and its light paths long; fog + spot (benchmark scene 4) 0.20x the path tracer's RMSE at equal
-    // time at 80x60 and 0.59x at 320x240. Under the sun, a dome or in thicker media the path tracer
-    // leads or the beams' gathers cost too much at large images (README, "Which integrator").
+    // time at 80x60 and 0.24x at 320x240 (since the automatic photon count pays for the beams'
+    // gathers). Under the sun, a dome or in thicker media the path tracer leads at the benchmark's
+    // quick size (README, "Which integrator").
     double meanDepth = media > 0 ? depthSum / media : 0;
     bool pointLit = !scene.lights().empty() && !scene.hasEmissiveMedia() &&
                     std::all_of(scene.lights().begin(), scene.lights().end(),
