@@ -224,7 +224,7 @@ class PhotonCache;
 /// MaxAutoPhotons (about 100 MB of photon map). With gathers the cost of a pass is C + (c + g)P, so
 /// the argument below holds with c + g for c; as g grows with the pixels, the count stops growing
 /// with them once gathers dominate (fog + spot's beams at 320 x 240: 48k a pass, where tracing alone
-/// gave 594k whose gathers took 6x the rest of the camera pass; equal-time RMSE 0.30x; the README,
+/// gave 594k whose gathers took 8.5x the rest of the camera pass; equal-time RMSE 0.30x; the README,
 /// "Photon maps: how many photons", has the figures).
 /// Why equal cost: the time to a given noise with P photons a pass is proportional to
 /// (a/P + b)(C + cP) (a/P: the photon map's variance, b: the camera side's, C and cP the two passes'
