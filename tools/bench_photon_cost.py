@@ -37,7 +37,7 @@ def render(name, w, h, passes, beams, photons):
 
 
 def modelled(cw, pw, gw, ray_cost, lookup_factor, base, gather_cost):
-    camera = cw["rays"] * ray_cost + cw["lookups"] + cw.get("gathers", 0) * gather_cost
+    camera = cw["rays"] * ray_cost + cw["lookups"]  # a camera pass without photons gathers none
     photon = base + pw["rays"] * ray_cost + pw["lookups"] * lookup_factor
     photon += gw["rays"] * ray_cost + gw["lookups"] + gw["gathers"] * gather_cost
     return camera / photon
