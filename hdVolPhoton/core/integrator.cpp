@@ -176,7 +176,11 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     const MediumStack cameraStack = scene.stackAt(camera.position());
     int translucent = 0, media = 0;
     double depthSum = 0;  // over the rays that cross media: their majorant optical depth, capped at DepthCap
+    double albedo = 0;    // the largest single-scattering albedo of the media they cross
     constexpr double DepthCap = 4, ThinDepth = 1;
+    // Open media: the photon map from SmallImagePixels (128^2) in thin media or at albedo HighAlbedo
+    // and up, from LargeImagePixels (256^2) at albedo MidAlbedo and up (measurements below).
+    constexpr double SmallImagePixels = 128 * 128, LargeImagePixels = 256 * 256, HighAlbedo = 0.95, MidAlbedo = 0.85;
     for (int j = 0; j < PilotH; ++j)
         for (int i = 0; i < PilotW; ++i) {
             double tMin, tMax;
@@ -192,6 +196,7 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
                 MediumAggregate segmentMedia = scene.mediaFor(stack);
                 if (segmentMedia.size() && depth < DepthCap)
                     segmentMedia.majorants(ray, tMin, tEnd, [&](const MajorantSegment& seg) {
+                        if (seg.sigmaMaj > 0) albedo = std::max(albedo, segmentMedia.maxAlbedo());
                         crossesMedia |= seg.sigmaMaj > 0;
                         depth += seg.opticalDepth(seg.tMax - seg.tMin);
                         return depth < DepthCap;
@@ -219,16 +224,14 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
                 "path tracer, and the path tracer's paths elsewhere"};
     // Thin open media lit only by point-like lights: photon beams (beam x beam, photonBeams.h) inform
     // every camera ray that passes near a photon's flight, where the path tracer's collisions are few
-    // and its light paths long; fog + spot (benchmark scene 4) 0.20x the path tracer's RMSE at equal
-    // time at 80x60 and 0.24x at 320x240 (since the automatic photon count pays for the beams'
-    // gathers). Under the sun, a dome or in thicker media the path tracer leads at the benchmark's
-    // quick size (README, "Which integrator").
+    // and its light paths long; fog + spot (benchmark scene 4) 0.11x-0.24x the path tracer's RMSE at
+    // equal time from 80x60 to 320x240.
     double meanDepth = media > 0 ? depthSum / media : 0;
     bool pointLit = !scene.lights().empty() && !scene.hasEmissiveMedia() &&
                     std::all_of(scene.lights().begin(), scene.lights().end(),
                                 [](const LightPtr& l) { return l->equiangularCenter().has_value(); });
-    char depthText[64];
-    std::snprintf(depthText, sizeof depthText, ", mean optical depth %.2g along them", meanDepth);
+    char depthText[96];
+    std::snprintf(depthText, sizeof depthText, ", mean optical depth %.2g along them, albedo up to %.2g", meanDepth, albedo);
     if (media > 0) view += depthText;
     if (media > 0 && meanDepth < ThinDepth && pointLit) {
         IntegratorChoice choice{I::PhotonMap, view + "; optically thin open media lit only by point, spot or sphere lights, "
@@ -236,7 +239,28 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
         choice.photonBeams = true;
         return choice;
     }
-    return {I::PathTracer, view + "; the path tracer leads on open media"};
+    // Other open media: the photon map's error at equal time falls against the path tracer's as the
+    // image grows (each photon serves the camera rays of every pixel near it; the path tracer's
+    // samples per pixel fall with the pixel count), the more so the more the light scatters. Measured
+    // photon map / path tracer at 80x60, 160x120, 320x240, 640x480, equal time (README, "Which
+    // integrator"): thin air under the sun (benchmark scene 5) 0.93, 0.49, 0.37 with points; albedo
+    // 0.99 (scene 3) 0.95, 0.62, 0.53, 0.24 with beams; albedo 0.9 (scene 2) 1.78, 1.01, 0.67, 0.37
+    // with points; albedo 0.8 (scene 1) 4.06, 2.25, 1.69, 0.84 with points; emissive soot of albedo
+    // 0.25 (scene 6) 0.84, 0.75, 0.92 with beams. The thresholds leave a margin for longer renders,
+    // where the photon map's kernel bias weighs more (at 32 s the 160x120 ratios were 1.1x-1.4x those
+    // at 4 s).
+    const double pixels = double(std::max(1, settings.width)) * std::max(1, settings.height);
+    std::string size = std::to_string(settings.width) + " x " + std::to_string(settings.height) + " pixels";
+    if (media > 0 && pixels >= SmallImagePixels && (meanDepth < ThinDepth || albedo >= HighAlbedo)) {
+        bool thin = meanDepth < ThinDepth;
+        IntegratorChoice choice{I::PhotonMap, view + "; at " + size + " the photon map leads the path tracer in " +
+                                (thin ? "optically thin media" : "media that scatter light many times (high albedo)")};
+        choice.photonBeams = !thin;
+        return choice;
+    }
+    if (media > 0 && pixels >= LargeImagePixels && albedo >= MidAlbedo)
+        return {I::PhotonMap, view + "; at " + size + " the photon map leads the path tracer in media of this albedo"};
+    return {I::PathTracer, view + "; the path tracer leads on these open media at " + size};
 }
 
 Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> photonCache)
@@ -357,18 +381,20 @@ const ImagePoint* Renderer::lightPixel(int x, int y) const {
 }
 
 work::Count Renderer::cameraPilotWork() const {
+    // One sample at the centre of each cell of a 16 x 16 grid over the image (fewer where the image
+    // is smaller): every row and column band is seen (a stride through the pixel index fell on 16
+    // columns at 320 wide).
     const int w = settings_.width, h = settings_.height;
-    const uint64_t pixels = uint64_t(w) * h;
-    const int n = static_cast<int>(std::min<uint64_t>(256, pixels));
+    const int nx = std::min(16, w), ny = std::min(16, h);
     Camera camera(scene_->desc().camera, w, h);
     work::Snapshot before = work::snapshot();
-    for (int k = 0; k < n; ++k) {
-        uint64_t i = k * pixels / n;  // spread over the image
-        Rng rng(hashKeys(0x50494c4fULL, settings_.seed, k));
-        PathRadiance L;
-        cameraSample(*integrator_, camera, static_cast<int>(i % w), static_cast<int>(i / w), rng, &L);
-    }
-    return work::since(before) * (double(pixels) / n);
+    for (int gy = 0; gy < ny; ++gy)
+        for (int gx = 0; gx < nx; ++gx) {
+            Rng rng(hashKeys(0x50494c4fULL, settings_.seed, gy * nx + gx));
+            PathRadiance L;
+            cameraSample(*integrator_, camera, (2 * gx + 1) * w / (2 * nx), (2 * gy + 1) * h / (2 * ny), rng, &L);
+        }
+    return work::since(before) * (double(w) * h / (nx * ny));
 }
 
 bool Renderer::renderPass(const CancelCallback& cancel) {

@@ -6,8 +6,9 @@
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, combined (the   |
 // |                     |        |            |              | path tracer with the photon map's multiple        |
 // |                     |        |            |              | scattering, combinedPhotonShare), or auto: one of |
-// |                     |        |            |              | pathTracer, combined or photonMap with beams per  |
-// |                     |        |            |              | scene by a pilot (chooseIntegrator)               |
+// |                     |        |            |              | pathTracer, combined or photonMap (points or      |
+// |                     |        |            |              | beams) per scene and image size by a pilot        |
+// |                     |        |            |              | (chooseIntegrator)                                |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
 // |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
@@ -117,7 +118,7 @@
 namespace volphoton {
 
 struct RenderSettings {
-    /// Auto: pathTracer or combined, chosen per scene by a pilot of camera rays (chooseIntegrator).
+    /// Auto: pathTracer, photonMap or combined, chosen per scene by a pilot of camera rays (chooseIntegrator).
     /// Combined: the path tracer's camera paths with the photon map's estimate of multiple scattering
     /// along their medium segments (PhotonEstimate, integratorBase.h), weighted by combinedPhotonShare.
     enum class Integrator { PathTracer, PhotonMap, Auto, Combined };
@@ -195,7 +196,8 @@ struct IntegratorChoice {
     std::string reason;
     /// Translucent objects in view and a delta light: the path tracer would miss that light inside.
     bool photonsOnly = false;
-    /// The photon map with photon beams (RenderSettings::photonBeams) for thin, point-lit open media.
+    /// The photon map with photon beams (RenderSettings::photonBeams): thin, point-lit open media, and
+    /// high-albedo media in images of 128 x 128 pixels and up.
     bool photonBeams = false;
 };
 /// integrator = auto: a pilot of 32 x 24 camera rays through the image finds what the view is made of:
@@ -206,8 +208,10 @@ struct IntegratorChoice {
 /// as photons (photonsOnly), and the path tracer's paths elsewhere (on the ball behind a fog bank it
 /// leads both). Open media alone: the photon map with photon beams where they are optically thin (mean
 /// majorant optical depth below 1 along the pilot rays that cross them) and every light is point-like
-/// (point, spot, sphere: fog + spot, benchmark scene 4), the path tracer otherwise (it leads on the
-/// other open-media benchmark scenes, tools/bench/README.md).
+/// (point, spot, sphere: fog + spot, benchmark scene 4). Other open media by the image's size, since
+/// the photon map gains on the path tracer as pixels share its photons: from 128 x 128 pixels the
+/// photon map in thin media (points) and in media of albedo >= 0.95 (beams), from 256 x 256 in media
+/// of albedo >= 0.85 (points); the path tracer otherwise (README, "Which integrator").
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;
@@ -322,7 +326,8 @@ private:
     static constexpr int LightPixelSamples = 16;
     /// The light image in pixel (x, y)'s footprint, or null.
     const ImagePoint* lightPixel(int x, int y) const;
-    /// The work (core/workCount.h) of one camera pass, from 256 deterministic camera samples.
+    /// The work (core/workCount.h) of one camera pass, from deterministic camera samples at the
+    /// centres of a 16 x 16 grid over the image.
     work::Count cameraPilotWork() const;
     /// After a pass: the active mask and the error statistics from the film.
     void updateAdaptive();

@@ -474,27 +474,30 @@ AUTO_CUBE = '''    def Cube "marble" (
 '''
 
 
-@pytest.mark.parametrize("translucent,density,chosen", [(True, 8, "combined"), (False, 8, "pathTracer"),
-                                                        (False, 0.2, "photonMap")])
-def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_env, translucent, density, chosen):
+@pytest.mark.parametrize("translucent,density,size,chosen", [(True, 8, (W, H), "combined"), (False, 8, (W, H), "pathTracer"),
+                                                             (False, 0.2, (W, H), "photonMap"),
+                                                             (False, 8, (168, 112), "photonMap")])
+def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_env, translucent, density, size, chosen):
     """integrator = auto (core chooseIntegrator): the pilot sees a translucent cube filling the middle
     of the view (a dielectric with a medium inside) and picks the combined integrator, the same cube as an
-    open medium and picks the path tracer, or it as thin fog (optical depth 0.32 across) lit only by the
-    sphere light and picks the photon map with beams.  In each door the auto image is bit-identical to the
-    one rendered with the chosen integrator named (with photonBeams for the fog), and the two doors agree."""
+    open medium and picks the path tracer at 48 x 32 pixels and the photon map with beams at 168 x 112
+    (albedo 0.99 from 128 x 128 pixels: the image size reaches the pilot through both doors), or it as
+    thin fog (optical depth 0.32 across) lit only by the sphere light and picks the photon map with beams.
+    In each door the auto image is bit-identical to the one rendered with the chosen integrator named
+    (with photonBeams for the photon map), and the two doors agree."""
     body = AUTO_CUBE % {"ior": "        float volphoton:ior = 1.3\n" if translucent else "", "density": density}
     beams = ["bool volphoton:photonBeams = 1"] if chosen == "photonMap" else []
     images = {}
     jobs, outs = [], []
     for integrator in ("auto", chosen):
         stage = tmp_path / ("%s.usda" % integrator)
-        stage.write_text(stage_text(body, 1, settings=['token volphoton:integrator = "%s"' % integrator, PHOTONS]
+        stage.write_text(stage_text(body, 1, size=size, settings=['token volphoton:integrator = "%s"' % integrator, PHOTONS]
                                     + (beams if integrator != "auto" else [])))
         for door in ("hydra", "cli"):
             out = str(tmp_path / ("%s.%s.exr" % (integrator, door)))
             outs.append(((integrator, door), out))
             if door == "hydra":
-                jobs.append(lambda s=str(stage), o=out: render_hydra(hydra_env, s, o, W))
+                jobs.append(lambda s=str(stage), o=out: render_hydra(hydra_env, s, o, size[0]))
             else:
                 jobs.append(lambda s=str(stage), o=out: render_cli(s, o))
     logs = run_parallel(jobs)

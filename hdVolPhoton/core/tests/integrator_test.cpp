@@ -921,6 +921,53 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     EXPECT_EQ(c.reason.find("translucent objects cover 0%"), std::string::npos) << c.reason;
 }
 
+TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
+    // A box of medium 2 units across under a distant light (so not the point-lit rule above). The
+    // photon map gains on the path tracer as the image grows (pixels share its photons): thin media
+    // and albedo >= 0.95 get it from 128 x 128 pixels (beams where the medium is not thin), albedo
+    // >= 0.85 from 256 x 256 (points), lower albedo keeps the path tracer (benchmark scenes 1, 2, 3
+    // and 5 at three sizes, README "Which integrator").
+    using I = RenderSettings::Integrator;
+    auto box = [](double sigmaT, double albedo) {
+        SceneDesc d;
+        auto c = MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(albedo), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
+        d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
+        d.unboundedMedia.push_back(0);
+        d.lights.push_back(makeDistantLight(normalize(Vec3(0.3, -1, 0.2)), 0.0, Spectrum(2.0)));
+        d.camera = lookAt(Vec3(0.2, 0.3, 3.5), Vec3(0, 0, 0), 0.3);
+        return d;
+    };
+    auto choose = [](const SceneDesc& d, int w, int h) {
+        RenderSettings s = smallSettings(I::Auto, 1, 5);
+        s.width = w;
+        s.height = h;
+        return chooseIntegrator(Scene(d), s);
+    };
+    struct Case {
+        double sigmaT, albedo;
+        int w, h;
+        I expected;
+        bool beams;
+    };
+    for (const Case& k : {Case{0.2, 0.9, 64, 48, I::PathTracer, false}, Case{0.2, 0.9, 160, 120, I::PhotonMap, false},
+                          Case{2.0, 0.99, 64, 48, I::PathTracer, false}, Case{2.0, 0.99, 160, 120, I::PhotonMap, true},
+                          Case{2.0, 0.9, 160, 120, I::PathTracer, false}, Case{2.0, 0.9, 320, 240, I::PhotonMap, false},
+                          Case{2.0, 0.8, 640, 480, I::PathTracer, false}}) {
+        IntegratorChoice c = choose(box(k.sigmaT, k.albedo), k.w, k.h);
+        EXPECT_EQ(c.integrator, k.expected) << k.sigmaT << " " << k.albedo << " " << k.w << ": " << c.reason;
+        EXPECT_EQ(c.photonBeams, k.beams) << k.sigmaT << " " << k.albedo << " " << k.w << ": " << c.reason;
+        EXPECT_NE(c.reason.find(std::to_string(k.w) + " x " + std::to_string(k.h) + " pixels"), std::string::npos) << c.reason;
+    }
+    EXPECT_NE(choose(box(2.0, 0.99), 160, 120).reason.find("albedo up to 0.99"), std::string::npos);
+    // The Renderer renders the choice.
+    RenderSettings s = smallSettings(I::Auto, 1, 5);
+    s.width = 160;
+    s.height = 120;
+    s.photonsPerPass = 1000;
+    Renderer r(std::make_shared<Scene>(box(2.0, 0.99)), s);
+    EXPECT_EQ(r.stats().integratorUsed, "photonMap");
+}
+
 TEST(IntegratorAovs, BeautyIsTheSumOfTheSplit) {
     SceneDesc d = mediaOnlyScene();
     d.lights.push_back(makeDomeLight(Spectrum(0.2)));

@@ -161,7 +161,7 @@ TEST(PhotonCount, AutomaticCountBalancesTheCameraPassDeterministically) {
         EXPECT_EQ(st->photonsPerPass, autoPhotonsPerPass(st->photonWorkRatio));
         EXPECT_EQ(st->photonsTraced, static_cast<uint64_t>(st->photonsPerPass));
     }
-    // A camera pass is 16x the work at 16x the pixels (the pilot's 256 samples spread over the image
+    // A camera pass is 16x the work at 16x the pixels (the pilot's 16 x 16 grid of samples over the image
     // see the same scene; 20% for their different pixels), and so is a stored photon's share of it
     // (its gathers: 16x the camera rays pass it).
     EXPECT_NEAR(large.cameraWork.units() / small.cameraWork.units(), 16.0, 16 * 0.2);
@@ -205,6 +205,31 @@ TEST(PhotonCount, GathersBoundTheCountAsTheImageGrows) {
     // 1.15x here (17k -> 20k beams); 16x without the gathers (130k -> 1e6, the cap).
     EXPECT_LT(large.photonWorkRatio / small.photonWorkRatio, 4.0);
     EXPECT_LT(double(large.photonsPerPass) / small.photonsPerPass, 4.0);
+}
+
+TEST(PhotonCount, TheCameraPilotSeesEveryColumnBand) {
+    // A dense slab seen only in the rightmost 5% of the columns (x >= 305 at 320 wide), the rest of
+    // the view empty: the camera pass's counted work per pixel must not depend on the resolution.
+    // The pilot once took every (pixels / 256)-th pixel index: at 320 x 240 those fell on 16 columns
+    // (0, 20, ..., 300), all left of the slab, and the pass was counted as empty.
+    SceneDesc d;
+    d.media.push_back(std::make_shared<HomogeneousMedium>(
+        MediumCoefficients::fromAlbedo(30, Spectrum(1.0), Spectrum(0.99), Spectrum(0.0), makeHenyeyGreensteinPhase(0.0)),
+        Bounds3{Vec3(1.85, -10, -0.1), Vec3(20, 10, 0.1)}));
+    d.unboundedMedia.push_back(0);
+    d.lights.push_back(makeDistantLight(normalize(Vec3(0.3, -1, -0.2)), 0.0, Spectrum(2.0)));
+    d.camera = lookAt(Vec3(0, 0, 5), Vec3(0, 0, 0), 0.4);
+    RenderSettings s = pmSettings(1);
+    s.photonsPerPass = 0;
+    auto perPixel = [&](int w, int h) {
+        s.width = w;
+        s.height = h;
+        return rendered(d, s)->stats().cameraWork.units() / (double(w) * h);
+    };
+    double small = perPixel(160, 120), large = perPixel(320, 240);
+    // The slab's pixels are all the pass costs (no mesh: a camera ray that misses it counts nothing).
+    EXPECT_GT(small, 0);
+    EXPECT_NEAR(large / small, 1.0, 0.2);  // 0.95 (the grid's cell centres); 0 before
 }
 
 TEST(PhotonCount, AResizedImageKeepsTheCachedAutomaticCount) {

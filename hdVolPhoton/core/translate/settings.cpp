@@ -49,7 +49,8 @@ std::vector<SettingInfo> makeTable() {
                  "volphoton:integrator", "Integrator", "",
                  "pathTracer (unbiased volumetric path tracer), photonMap (single-scattering march + volume photon map), "
                  "combined (path-traced camera paths with the photon map's multiple scattering) "
-                 "or auto (pathTracer, combined, or photonMap with beams per scene from a pilot of camera rays; the stats say which and why)",
+                 "or auto (pathTracer, combined, or photonMap with points or beams per scene and image size from a pilot of "
+                 "camera rays; the stats say which and why)",
                  [](const RS& s) { return AttrValue(integratorName(s.integrator)); },
                  [](RS& s, const AttrValue& v) { parseIntegrator(std::get<std::string>(v), &s.integrator); }});
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
