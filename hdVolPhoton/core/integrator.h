@@ -211,7 +211,8 @@ struct IntegratorChoice {
 /// (point, spot, sphere: fog + spot, benchmark scene 4). Other open media by the image's size, since
 /// the photon map gains on the path tracer as pixels share its photons: from 128 x 128 pixels the
 /// photon map in thin media (points) and in media of albedo >= 0.95 (beams), from 256 x 256 in media
-/// of albedo >= 0.85 (points); the path tracer otherwise (README, "Which integrator").
+/// of albedo >= 0.85 (points), unless opaque surfaces fill more than half the view; the path tracer
+/// otherwise (README, "Which integrator").
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;
