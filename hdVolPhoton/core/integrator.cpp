@@ -229,13 +229,14 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // and its light paths long; fog + spot (benchmark scene 4) 0.11x-0.24x the path tracer's RMSE at
     // equal time from 80x60 to 320x240.
     double meanDepth = media > 0 ? depthSum / media : 0;
+    const bool thin = meanDepth < ThinDepth;
     bool pointLit = !scene.lights().empty() && !scene.hasEmissiveMedia() &&
                     std::all_of(scene.lights().begin(), scene.lights().end(),
                                 [](const LightPtr& l) { return l->equiangularCenter().has_value(); });
     char depthText[96];
     std::snprintf(depthText, sizeof depthText, ", mean optical depth %.2g along them, albedo up to %.2g", meanDepth, albedo);
     if (media > 0) view += depthText;
-    if (media > 0 && meanDepth < ThinDepth && pointLit) {
+    if (media > 0 && thin && pointLit) {
         IntegratorChoice choice{I::PhotonMap, view + "; optically thin open media lit only by point, spot or sphere lights, "
                                 "where photon beams lead the path tracer"};
         choice.photonBeams = true;
@@ -254,12 +255,11 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // Only where opaque surfaces fill at most half the view: the photon map's camera paths sample
     // lights without MIS at surfaces (2x the path tracer's RMSE on benchmark scene 7), and the
     // measured scenes show at most 42% (the atmosphere's ground).
-    const double pixels = double(std::max(1, settings.width)) * std::max(1, settings.height);
-    std::string size = std::to_string(settings.width) + " x " + std::to_string(settings.height) + " pixels";
     if (2 * surfaces > PilotW * PilotH)
         return {I::PathTracer, view + "; opaque surfaces fill most of the view, where the path tracer leads"};
-    if (media > 0 && pixels >= SmallImagePixels && (meanDepth < ThinDepth || albedo >= HighAlbedo)) {
-        bool thin = meanDepth < ThinDepth;
+    const double pixels = double(std::max(1, settings.width)) * std::max(1, settings.height);
+    std::string size = std::to_string(settings.width) + " x " + std::to_string(settings.height) + " pixels";
+    if (media > 0 && pixels >= SmallImagePixels && (thin || albedo >= HighAlbedo)) {
         IntegratorChoice choice{I::PhotonMap, view + "; at " + size + " the photon map leads the path tracer in " +
                                 (thin ? "optically thin media" : "media that scatter light many times (high albedo)")};
         choice.photonBeams = !thin;

@@ -484,7 +484,7 @@ def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_e
     (albedo 0.99 from 128 x 128 pixels: the image size reaches the pilot through both doors), or it as
     thin fog (optical depth 0.32 across) lit only by the sphere light and picks the photon map with beams.
     In each door the auto image is bit-identical to the one rendered with the chosen integrator named
-    (with photonBeams for the photon map), and the two doors agree."""
+    (with photonBeams for the photon map), so both doors make the same choice."""
     body = AUTO_CUBE % {"ior": "        float volphoton:ior = 1.3\n" if translucent else "", "density": density}
     beams = ["bool volphoton:photonBeams = 1"] if chosen == "photonMap" else []
     images = {}
