@@ -800,14 +800,14 @@ def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
 def test_integrator_combined_renders_through_the_cli(tmp_path):
     """--integrator combined: path-traced camera paths, and inside a translucent object (a dielectric
     with a medium inside, where no shadow ray reaches a light) the photon map's multiple scattering;
-    the stats say so, with the photons traced and the open-media share (default 0)."""
+    the stats say so, with the photons traced and the open-media share (default -1: automatic, here 0)."""
     stage, path = stage_from(tmp_path, MEDIUM_CUBE % "1.3")
     stats = tmp_path / "s.json"
     r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "2",
                 "--integrator", "combined", "--photons", "2000")
     assert r.returncode == 0, r.stderr
     st = json.loads(stats.read_text())["frames"][0]
-    assert st["settings"]["integrator"] == "combined" and st["settings"]["combinedPhotonShare"] == 0.0
+    assert st["settings"]["integrator"] == "combined" and st["settings"]["combinedPhotonShare"] == -1.0
     assert st["render"]["integrator_used"] == "combined"
     assert st["render"]["photons_traced"] > 0 and st["render"]["photons_stored"] > 0
     assert "single scattering (path-traced: combined)" in st["render"]["passes_run"]

@@ -2,7 +2,7 @@
 """Equal-time RMSE where a point-like light is in view (issue 15, scene 4): a path-traced reference of
 --reference seconds in 8 batches (its own noise estimated from them and removed from every MSE), then
 --seeds renders of --seconds each with the path tracer, the photon map with points and with beams
-(80x60 unless --resolution, the scene's settings, 2 threads), and the share of each render's squared error in its worst
+(or the integrators of --variants; 80x60 unless --resolution, the scene's settings, 2 threads), and the share of each render's squared error in its worst
 pixel (the light's pixel held most of it before Renderer::lightPixels_).
 
     python tools/bench_light_pixel.py                        # fog + spot, 320 s reference, ~7 min
@@ -20,13 +20,27 @@ from volphoton import _core
 SIZE = [80, 60]
 
 
-def render(scene, rs, integrator, seed, seconds, beams=False):
+# --variants: label -> (integrator, photonBeams, combinedPhotonShare; -1: automatic, the default).
+VARIANTS = {
+    "pathTracer": ("PathTracer", False, -1.0),
+    "points": ("PhotonMap", False, -1.0),
+    "beams": ("PhotonMap", True, -1.0),
+    "auto": ("Auto", False, -1.0),
+    "combined": ("Combined", False, -1.0),
+    "combined0": ("Combined", False, 0.0),
+    "combined1": ("Combined", False, 1.0),
+    "combined1beams": ("Combined", True, 1.0),
+}
+
+
+def render(scene, rs, integrator, seed, seconds, beams=False, share=-1.0):
     s = rs.settings
     s.width, s.height, s.seed, s.threads = SIZE[0], SIZE[1], seed, 2
     s.noise_target, s.time_limit = 0, seconds
     s.samples_per_pixel = s.max_samples_per_pixel = 10000000
     s.integrator = getattr(_core.RenderSettings.Integrator, integrator)
     s.photon_beams = beams
+    s.combined_photon_share = share
     r = _core.Renderer(scene, s)
     r.render()
     return np.asarray(r.film.beauty, np.float64)
@@ -39,6 +53,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=4)
     ap.add_argument("--resolution", nargs=2, type=int, default=list(SIZE), metavar=("W", "H"))
     ap.add_argument("--reference", type=float, default=320.0, help="seconds of the path-traced reference")
+    ap.add_argument("--variants", default="pathTracer,points,beams",
+                    help="comma-separated, of " + ", ".join(VARIANTS) + " (combined: its defaults; combined0/1: photon share 0/1)")
     ap.add_argument("--save", help="write the reference's batches to this .npz")
     ap.add_argument("--load", help="read the reference's batches from this .npz instead of rendering it")
     a = ap.parse_args()
@@ -55,11 +71,11 @@ def main():
     ref_var = (batches.var(0, ddof=1) / len(batches)).mean()
     print("%s: reference %s, its noise RMSE %.6f (removed below); %s" % (
         a.scene, a.load or "%g s" % a.reference, np.sqrt(ref_var), _core.__file__))
-    for label, integrator, beams in (("pathTracer", "PathTracer", False), ("photonMap points", "PhotonMap", False),
-                                     ("photonMap beams", "PhotonMap", True)):
+    for label in a.variants.split(","):
+        integrator, beams, share = VARIANTS[label]
         mse, worst = [], []
         for seed in range(a.seeds):
-            d2 = ((render(scene, rs, integrator, seed, a.seconds, beams) - ref) ** 2).mean(2)
+            d2 = ((render(scene, rs, integrator, seed, a.seconds, beams, share) - ref) ** 2).mean(2)
             mse.append(d2.mean() - ref_var)
             worst.append(d2.max() / d2.sum())
         print("%s, %g s x %d seeds: RMSE %.6f; per seed %s; worst pixel's share of the squared error %s" % (

@@ -52,12 +52,16 @@
 // |                     |        |            | paths        | mean free paths (1/max sigma_t) at the photon,    |
 // |                     |        |            |              | for media not bounded by a closed mesh (inside one|
 // |                     |        |            |              | gathering stops at the mesh); 0: no cap           |
-// | combinedPhotonShare | double | 0          | [0, 1]       | combined: the photon map's share w of the light   |
+// | combinedPhotonShare | double | -1 (auto)  | [0, 1], -1   | combined: the photon map's share w of the light   |
 // |                     |        |            |              | scattered more than once at a camera path's vertex|
 // |                     |        |            |              | in open media (inside translucent objects it is   |
 // |                     |        |            |              | 1); the path goes on for the rest with probability|
 // |                     |        |            |              | 1 - w. 0: the path tracer's in open media (photons|
-// |                     |        |            |              | only for translucent objects)                     |
+// |                     |        |            |              | only for translucent objects). -1 (auto): where   |
+// |                     |        |            |              | auto's pilot picks the photon map, camera segments|
+// |                     |        |            |              | in open media are the photon map's (its march's   |
+// |                     |        |            |              | single scattering, its gather with auto's points  |
+// |                     |        |            |              | or beams), else 0 (Renderer)                      |
 // | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
 // |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
 // |                     |        |            |              | photon points, where media are optically thin     |
@@ -142,7 +146,7 @@ struct RenderSettings {
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 8;
     bool photonBeams = false;
-    double combinedPhotonShare = 0.0;
+    double combinedPhotonShare = -1;  ///< -1: auto (combinedShare)
     int stratifiedDims = 516;  // camera + 16 segments of Rng::SegmentDims
     double marchStep = 0;
     bool singleScattering = true;

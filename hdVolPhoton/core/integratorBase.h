@@ -223,7 +223,9 @@ double fresnelDielectric(double cosI, double eta);
 /// after one or more scattering events (or a bounce or a refraction) and scatters towards the camera
 /// along it, the photon-map integrator's multiple-scattering gather. The path tracer weights it by
 /// share(stack) and continues its own paths from medium collisions with probability 1 - share: the
-/// two estimates of multiply scattered light are mixed per vertex (pathTracer.cpp).
+/// two estimates of multiply scattered light are mixed per vertex (pathTracer.cpp). Where the photon
+/// side takes the whole segment (wholeSegment) the segment is the photon-map integrator's camera
+/// segment: its march's single scattering too (in open media), no collision sampled.
 class PhotonEstimate {
 public:
     virtual ~PhotonEstimate() = default;
@@ -232,12 +234,19 @@ public:
     /// nothing there, and a delta light's light arrives only as photons), settings.combinedPhotonShare
     /// elsewhere; 0 when this pass has no photons.
     virtual double share(const MediumStack& stack) const = 0;
+    /// Whether a segment in the media of `stack` is the photon-map integrator's camera segment (share
+    /// 1 there): inside translucent objects, and in open media when the combined integrator's automatic
+    /// share found the photon map leading there (makePhotonMapper's openMediaSegments).
+    virtual bool wholeSegment(const MediumStack& stack) const = 0;
     struct Along {
+        Spectrum single;    ///< whole segments in open media: the march's single scattering
         Spectrum multiple;  ///< the gather, per unit camera throughput
         Spectrum T{1.0};    ///< the segment's transmittance (closed form, else marched)
+        bool interacted = false;  ///< the segment crossed a medium of nonzero density
     };
     /// The gather along local.o + t local.d, t in [0, length], in the media `media` (transmittance
-    /// from local.o included), and the transmittance over the whole segment.
+    /// from local.o included), single scattering too where wholeSegment(stack), and the
+    /// transmittance over the whole segment. Emission stays the path tracer's.
     virtual Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack,
                         Rng& rng) const = 0;
 };
@@ -245,7 +254,9 @@ public:
 /// `photons`: integrator = combined's photon estimate (null: the path tracer alone).
 std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings,
                                            const PhotonEstimate* photons = nullptr);
+/// openMediaSegments (integrator = combined): camera segments in open media are the photon map's too
+/// (wholeSegment), as where auto would pick the photon map (the Renderer's automatic share).
 std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
-                                             std::shared_ptr<PhotonCache> cache = nullptr);
+                                             std::shared_ptr<PhotonCache> cache = nullptr, bool openMediaSegments = false);
 
 }  // namespace volphoton

@@ -27,8 +27,9 @@
 //
 // Integrator 3, combined, is this class too: its photon passes, and the path tracer's camera paths
 // (cameraPaths_, pathTracer.cpp) asking it for the multiple-scattering gather along their segments
-// (PhotonEstimate, integratorBase.h: share() and along()). With combinedPhotonShare 0 it stores
-// photons inside translucent objects only (storedIn) and traces none where there is no such object.
+// (PhotonEstimate, integratorBase.h: share(), wholeSegment() and along()). With combinedPhotonShare 0
+// it stores photons inside translucent objects only (storedIn) and traces none where there is no such
+// object; with openMediaSegments its march takes single scattering in open media too.
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -50,8 +51,10 @@ constexpr int PhotonBatch = 4096;
 
 class PhotonMapper final : public Integrator, public PhotonEstimate {
 public:
-    PhotonMapper(const Scene& scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache)
-        : Integrator(scene, settings), cache_(std::move(cache)) {
+    PhotonMapper(const Scene& scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache, bool openMediaSegments)
+        : Integrator(scene, settings),
+          openSegments_(openMediaSegments && settings.integrator == RenderSettings::Integrator::Combined),
+          cache_(std::move(cache)) {
         // integrator = combined: the path tracer's camera paths, asking this map along their segments.
         if (settings.integrator == RenderSettings::Integrator::Combined) {
             cameraPaths_ = makePathTracer(scene, settings, this);
@@ -212,11 +215,12 @@ public:
     /// integrator's short camera paths, not the path tracer's full ones.
     double share(const MediumStack& stack) const override {
         if (!(map_ || beams_ || !passesDecided_)) return 0.0;
-        return scene_.sealedFromLights(stack) ? 1.0 : settings_.combinedPhotonShare;
+        return wholeSegment(stack) ? 1.0 : settings_.combinedPhotonShare;
     }
+    bool wholeSegment(const MediumStack& stack) const override { return openSegments_ || scene_.sealedFromLights(stack); }
     Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack, Rng& rng) const override {
-        SegmentResult r = integrateSegment(media, local, length, stack, rng, /*gatherOnly=*/true);
-        return {r.multiple, r.T};
+        SegmentResult r = integrateSegment(media, local, length, stack, rng, openSegments_ ? Parts::Scattered : Parts::Gather);
+        return {r.single, r.multiple, r.T, r.interacted};
     }
 
     PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
@@ -324,19 +328,21 @@ private:
         }
     };
 
-    /// gatherOnly: the multiple-scattering gather alone (integrator = combined, whose path tracer
-    /// estimates single scattering and emission); the march then runs only for a transmittance without
-    /// closed form.
+    /// What integrateSegment estimates: everything (the photon-map integrator's camera paths); single
+    /// and multiple scattering (combined, whole segments in open media: the path tracer estimates
+    /// emission); the multiple-scattering gather alone (combined elsewhere: the path tracer estimates
+    /// single scattering and emission; the march then runs only for a transmittance without closed form).
+    enum class Parts { All, Scattered, Gather };
     SegmentResult integrateSegment(const MediumAggregate& media, const Ray& ray, double length, const MediumStack& stack, Rng& rng,
-                                   bool gatherOnly = false) const {
+                                   Parts parts = Parts::All) const {
         SegmentResult r;
         SegmentTransmittance tr;
         tr.media = &media;
         tr.ray = &ray;
         tr.closedForm = static_cast<bool>(media.opticalDepth(ray, 0.0, 0.0));
-        bool emissive = !gatherOnly && media.isEmissive();
+        bool emissive = parts == Parts::All && media.isEmissive();
         // No light sampling inside a dielectric that no shadow ray can leave (Scene::sealedFromLights).
-        bool single = !gatherOnly && settings_.singleScattering && !scene_.sealedFromLights(stack);
+        bool single = parts != Parts::Gather && settings_.singleScattering && !scene_.sealedFromLights(stack);
         double weight = 1.0;  // Russian-roulette weight of the march's early termination
         Spectrum tauRun;      // marched optical depth so far
         double supportStart = Infinity, supportEnd = 0;
@@ -1014,7 +1020,9 @@ private:
             settings_.singleScattering = false;
             return;
         }
-        if (cameraPaths_) stats.passesRun.push_back("single scattering (path-traced: combined)");
+        if (cameraPaths_)
+            stats.passesRun.push_back(openSegments_ ? "single scattering (marched in open media: combined)"
+                                                    : "single scattering (path-traced: combined)");
         else if (settings_.singleScattering) stats.passesRun.push_back("single scattering");
         else stats.passesSkipped.push_back("single scattering: disabled by settings");
         if (scene_.hasEmissiveMedia() && emitters_.empty())
@@ -1132,6 +1140,7 @@ private:
     std::vector<bool> beamRegions_;  ///< photonBeams: region + 1 -> beams there (beamsIn)
     bool hasExtended_ = false, hasMeshMedia_ = false, photonsEnabled_ = false, passesDecided_ = false;
     bool sealedOnly_ = false;  ///< combined with combinedPhotonShare 0: photons stored in translucent objects only
+    const bool openSegments_;  ///< combined: camera segments in open media are this map's too (wholeSegment)
     std::shared_ptr<const PhotonMap> map_;  ///< this pass's map (traced, or kept in cache_)
     std::shared_ptr<const PhotonBeamMap> beams_;  ///< or its beams (photonBeams)
     std::shared_ptr<PhotonCache> cache_;
@@ -1144,8 +1153,8 @@ private:
 }  // namespace
 
 std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
-                                             std::shared_ptr<PhotonCache> cache) {
-    return std::make_unique<PhotonMapper>(scene, settings, std::move(cache));
+                                             std::shared_ptr<PhotonCache> cache, bool openMediaSegments) {
+    return std::make_unique<PhotonMapper>(scene, settings, std::move(cache), openMediaSegments);
 }
 
 }  // namespace volphoton

@@ -36,7 +36,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
 /// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
 /// | volphoton:photonBeams        | bool  | false      | photonMap: beams where media are thin        |
-/// | volphoton:combinedPhotonShare| float | 0          | combined: photons' share in open media       |
+/// | volphoton:combinedPhotonShare| float | -1 (auto)  | combined: photons' share in open media       |
 /// | volphoton:marchStep          | float | 0 (auto)   | photonMap: single-scattering march step      |
 /// | volphoton:multipleThreshold  | float | 1e-3       | photonMap: skip photons below this ratio     |
 /// | volphoton:transmittanceCutoff| float | 0          | deterministic early termination (biased)     |

@@ -201,7 +201,8 @@ def test_integrator_setting_as_token_or_string(tmp_path, hydra_env):
     token or as a string (the delegate's descriptor is a string so usdview's dialog can edit it):
     the two spellings render bit-identically, "pathTracer" as the default does, and "photonMap"
     differently (the photon map's passes draw other random numbers), "auto" as the path tracer here,
-    "combined" as the path tracer too (no translucent object, no photon share in open media)."""
+    "combined" as the path tracer too (no translucent object, and its automatic open-media share
+    follows auto: no photons)."""
     variants = {"default": "", "pathTracerToken": 'token volphoton:integrator = "pathTracer"',
                 "pathTracerString": 'string volphoton:integrator = "pathTracer"',
                 "photonMapToken": 'token volphoton:integrator = "photonMap"',

@@ -755,6 +755,21 @@ TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
     EXPECT_NEAR(a.mean, b.mean, 4 * std::hypot(a.stderr_, b.stderr_) + 0.02 * a.mean);
 }
 
+namespace {
+/// A fog box 2 units across (albedo 0.9, HG 0.3) lit by a point light and a small sphere light: at
+/// sigma_t 0.2 (optical depth 0.4 across) auto picks the photon map with beams at any image size.
+SceneDesc pointLitFog(double sigmaT) {
+    SceneDesc d;
+    auto c = MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
+    d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
+    d.unboundedMedia.push_back(0);
+    d.lights.push_back(makeSphereLight(Vec3(0.3, 0.5, 0.2), 0.0, Spectrum(1.0)));
+    d.lights.push_back(makeSphereLight(Vec3(-0.4, 0.2, -0.3), 0.1, Spectrum(0.5)));
+    d.camera = lookAt(Vec3(0.2, 0.3, 3.5), Vec3(0, 0, 0), 0.3);
+    return d;
+}
+}  // namespace
+
 TEST(IntegratorAuto, ThePilotPicksCombinedForTranslucentObjectsAndThePathTracerForOpenMedia) {
     // integrator = auto (chooseIntegrator): a translucent box (dielectric, medium inside) filling the
     // view under a dome -> combined; the same box behind a fog box that covers the view -> combined
@@ -851,16 +866,7 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     // with a distant light instead, or ten times denser (optical depth 4) -> the path tracer. Media
     // behind index-matched boundaries count as media in view.
     using I = RenderSettings::Integrator;
-    auto fog = [](double sigmaT) {
-        SceneDesc d;
-        auto c = MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
-        d.media.push_back(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}));
-        d.unboundedMedia.push_back(0);
-        d.lights.push_back(makeSphereLight(Vec3(0.3, 0.5, 0.2), 0.0, Spectrum(1.0)));
-        d.lights.push_back(makeSphereLight(Vec3(-0.4, 0.2, -0.3), 0.1, Spectrum(0.5)));
-        d.camera = lookAt(Vec3(0.2, 0.3, 3.5), Vec3(0, 0, 0), 0.3);
-        return d;
-    };
+    auto fog = pointLitFog;
     RenderSettings s = smallSettings(I::Auto, 2, 5);
     auto choose = [&](const SceneDesc& d) { return chooseIntegrator(Scene(d), s); };
     SceneDesc thin = fog(0.2);
@@ -1155,6 +1161,7 @@ std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
     point.lights = {makeSphereLight(Vec3(0.4, 0.2, 0.3), 0.0, Spectrum(3.0))};
     scenes.emplace_back("fog around a point light", point);
     scenes.emplace_back("emissive cloud beside fog", emissiveCloudBesideFog());
+    scenes.emplace_back("thin fog around a point and a sphere light", pointLitFog(0.45));
     // A translucent box (a dielectric of n = 1.3 with a medium inside) in thin fog under a dome: inside
     // it the photons take all multiple scattering whatever the share; outside, the share decides.
     SceneDesc translucent;
@@ -1179,7 +1186,7 @@ std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
 
 TEST(IntegratorCombined, PhotonShareZeroIsThePathTracerExactly) {
     // The weights of the two estimates of multiply scattered light at a medium vertex are share and
-    // 1 - share (pathTracer.cpp): at share 0 (the default) in scenes without translucent objects the
+    // 1 - share (pathTracer.cpp): at share 0 in scenes without translucent objects the
     // photons' weight is 0 everywhere and the path always goes on, so the image is the path tracer's
     // bit for bit, and no photon is traced (the stats say why).
     for (auto& [name, d] : combinedScenes()) {
@@ -1187,7 +1194,7 @@ TEST(IntegratorCombined, PhotonShareZeroIsThePathTracerExactly) {
         if (scene->hasSealedMeshes()) continue;  // a translucent object takes the photons at any share
         RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 4, 7), combined = pt;
         combined.integrator = RenderSettings::Integrator::Combined;
-        ASSERT_EQ(combined.combinedPhotonShare, 0.0);
+        combined.combinedPhotonShare = 0;
         Renderer a(scene, pt), b(scene, combined);
         a.render();
         b.render();
@@ -1200,10 +1207,56 @@ TEST(IntegratorCombined, PhotonShareZeroIsThePathTracerExactly) {
     }
 }
 
+TEST(IntegratorCombined, TheDefaultShareFollowsAutosPilot) {
+    // combinedPhotonShare -1 (the default): where chooseIntegrator picks the photon map, camera
+    // segments in open media are the photon map's (its march's single scattering, its gather with
+    // auto's points or beams); elsewhere share 0, bit for bit the render with share 0 named. The stats
+    // say which and why. The scenes hold both cases (the point-lit fog gets beams; the others keep the
+    // path tracer's paths in open media), so a default that ignored the pilot, or a choice the render
+    // did not follow, fails here; that the photon case is right is AgreesWithThePathTracerPerAovAtEveryShare's.
+    using I = RenderSettings::Integrator;
+    int photonScenes = 0, pathScenes = 0;
+    for (auto& [name, d] : combinedScenes()) {
+        auto scene = std::make_shared<Scene>(d);
+        RenderSettings byDefault = smallSettings(I::Combined, 4, 7), named = byDefault;
+        ASSERT_EQ(byDefault.combinedPhotonShare, -1.0);
+        IntegratorChoice choice = chooseIntegrator(*scene, byDefault);
+        const bool photons = choice.integrator == I::PhotonMap;
+        named.combinedPhotonShare = photons ? 1 : 0;
+        named.photonBeams = photons && choice.photonBeams;
+        Renderer a(scene, byDefault), b(scene, named);
+        a.render();
+        b.render();
+        // Share 1 named keeps the path tracer's single scattering: the images differ by the march.
+        if (photons) {
+            EXPECT_NE(a.film().resolveRgb(Film::Single), b.film().resolveRgb(Film::Single)) << name;
+        } else {
+            EXPECT_EQ(a.film().resolveRgb(Film::Beauty), b.film().resolveRgb(Film::Beauty)) << name;
+        }
+        const auto& run = a.stats().passesRun;
+        EXPECT_EQ(std::count(run.begin(), run.end(), "single scattering (marched in open media: combined)"), photons ? 1 : 0) << name;
+        EXPECT_EQ(a.stats().integratorReason.rfind(photons ? "open media by the photon map" : "open media by the path tracer", 0), 0u)
+            << name << ": " << a.stats().integratorReason;
+        EXPECT_NE(a.stats().integratorReason.find(choice.reason), std::string::npos) << name;
+        if (photons) {
+            EXPECT_GT(a.stats().photonsTraced, 0u) << name;
+        }
+        photonScenes += photons;
+        pathScenes += !photons;
+    }
+    EXPECT_GT(photonScenes, 0);
+    EXPECT_GT(pathScenes, 0);
+    // Only -1 stands for auto: other negative shares are refused.
+    RenderSettings bad = smallSettings(I::Combined, 1, 0);
+    bad.combinedPhotonShare = -0.5;
+    EXPECT_THROW(Renderer(std::make_shared<Scene>(combinedScenes()[0].second), bad), std::invalid_argument);
+}
+
 TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
     // Single scattering and volume emission are the path tracer's own estimators in the combined
-    // integrator: they must agree with the path tracer within the noise alone (4 standard errors over
-    // 8 seeds). Multiple scattering mixes the photon gather (weight share) with the continued path
+    // integrator (with the automatic share -1 where auto picks the photon map, single scattering is
+    // the photon map's march in open media, unbiased too): they must agree with the path tracer within
+    // the noise alone (4 standard errors over 8 seeds). Multiple scattering mixes the photon gather (weight share) with the continued path
     // (probability 1 - share): within the noise plus 3% of it for the photon kernel's bias (initial
     // radius 0.05 of 2-unit boxes). The check has teeth: 4 sigma below 8% of the multiple part.
     const Film::Aov aovs[4] = {Film::Single, Film::Multiple, Film::Emission, Film::Beauty};
@@ -1226,9 +1279,16 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
     for (auto& [name, d] : combinedScenes()) {
         const auto ref = means(d, smallSettings(RenderSettings::Integrator::PathTracer, 256, 0));
         const bool translucent = name.find("translucent") != std::string::npos;
-        for (double share : {0.0, 1.0, 0.5}) {
-            // Share 0 without a translucent object is the path tracer itself (PhotonShareZeroIsThePathTracerExactly).
+        for (double share : {0.0, 1.0, 0.5, -1.0}) {
+            // Share 0 without a translucent object is the path tracer itself (PhotonShareZeroIsThePathTracerExactly),
+            // and so is the automatic share (-1) where auto keeps the path tracer (TheDefaultShareFollowsAutosPilot).
             if (share == 0 && !translucent) continue;
+            // The point-lit fog is here for the automatic share; intermediate shares are the other scenes'
+            // (at 0.5 its continued paths' noise leaves no room for the 8% check below).
+            if (share == 0.5 && name.find("point and a sphere") != std::string::npos) continue;
+            if (share < 0 && chooseIntegrator(Scene(d), smallSettings(RenderSettings::Integrator::Combined, 32, 0)).integrator !=
+                                 RenderSettings::Integrator::PhotonMap)
+                continue;
             RenderSettings c = smallSettings(RenderSettings::Integrator::Combined, 32, 0);
             c.photonsPerPass = 16000;
             c.combinedPhotonShare = share;

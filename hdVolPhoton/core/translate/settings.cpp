@@ -87,10 +87,11 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(doubleSetting("photonRadiusMfp", 0, Big, "", "Photon radius cap (mean free paths)", "mean free paths",
                               "photonMap: a photon's radius is at most this many mean free paths (0: no cap)",
                               &RS::photonRadiusMfp));
-    t.push_back(doubleSetting("combinedPhotonShare", 0, 1, "", "Combined: photon share", "",
+    t.push_back(doubleSetting("combinedPhotonShare", -1, 1, "", "Combined: photon share (-1: auto)", "",
                               "combined: the photon map's share of the light scattered more than once at a camera "
                               "path's vertex in open media (1 inside translucent objects); the path goes on for the "
-                              "rest with probability 1 - share (0: the path tracer's in open media)",
+                              "rest with probability 1 - share (0: the path tracer's in open media; -1: where auto would "
+                              "pick the photon map, the photon map's single and multiple scattering in open media, else 0)",
                               &RS::combinedPhotonShare));
     t.push_back(boolSetting("photonBeams", "", "Photon beams",
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points where media are "
