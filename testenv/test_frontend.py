@@ -809,6 +809,9 @@ def test_integrator_combined_renders_through_the_cli(tmp_path):
     st = json.loads(stats.read_text())["frames"][0]
     assert st["settings"]["integrator"] == "combined" and st["settings"]["combinedPhotonShare"] == -1.0
     assert st["render"]["integrator_used"] == "combined"
+    # The automatic share asks auto's pilot, which keeps open media to the path tracer here, and says so.
+    assert st["render"]["integrator_reason"].startswith("open media by the path tracer: translucent objects cover")
+    assert "combined (open media by the path tracer: " in r.stderr + r.stdout, r.stderr
     assert st["render"]["photons_traced"] > 0 and st["render"]["photons_stored"] > 0
     assert "single scattering (path-traced: combined)" in st["render"]["passes_run"]
     assert "multiple scattering (photons)" in st["render"]["passes_run"]

@@ -3,7 +3,8 @@
 --reference seconds in 8 batches (its own noise estimated from them and removed from every MSE), then
 --seeds renders of --seconds each with the path tracer, the photon map with points and with beams
 (or the integrators of --variants; 80x60 unless --resolution, the scene's settings, 2 threads), and the share of each render's squared error in its worst
-pixel (the light's pixel held most of it before Renderer::lightPixels_).
+pixel (the light's pixel held most of it before Renderer::lightPixels_), and each variant's image mean
+per channel against the reference's with its standard error over the seeds (the kernel bias).
 
     python tools/bench_light_pixel.py                        # fog + spot, 320 s reference, ~7 min
     python tools/bench_light_pixel.py --reference 60 --seeds 2
@@ -73,14 +74,23 @@ def main():
         a.scene, a.load or "%g s" % a.reference, np.sqrt(ref_var), _core.__file__))
     for label in a.variants.split(","):
         integrator, beams, share = VARIANTS[label]
-        mse, worst = [], []
+        mse, worst, means = [], [], []
         for seed in range(a.seeds):
-            d2 = ((render(scene, rs, integrator, seed, a.seconds, beams, share) - ref) ** 2).mean(2)
+            img = render(scene, rs, integrator, seed, a.seconds, beams, share)
+            d2 = ((img - ref) ** 2).mean(2)
             mse.append(d2.mean() - ref_var)
             worst.append(d2.max() / d2.sum())
+            means.append(img.reshape(-1, 3).mean(0))
         print("%s, %g s x %d seeds: RMSE %.6f; per seed %s; worst pixel's share of the squared error %s" % (
             label, a.seconds, a.seeds, np.sqrt(max(np.mean(mse), 0)), " ".join("%.5f" % np.sqrt(max(m, 0)) for m in mse),
             " ".join("%.0f%%" % (100 * w) for w in worst)), flush=True)
+        # The image mean per channel against the reference's: the kernel bias shows here when it
+        # exceeds the standard error over the seeds (combined with the reference's over its batches).
+        ref_means = batches.reshape(len(batches), -1, 3).mean(1)
+        rel = np.mean(means, 0) / ref_means.mean(0) - 1
+        se = np.hypot(np.std(means, 0, ddof=1) / np.sqrt(a.seeds), ref_means.std(0, ddof=1) / np.sqrt(len(batches))) / ref_means.mean(0)
+        print("    image mean vs reference per channel: %s" % ", ".join(
+            "%+.2f%% (se %.2f%%, z %.1f)" % (100 * r, 100 * e, r / e if e > 0 else 0) for r, e in zip(rel, se)), flush=True)
 
 
 if __name__ == "__main__":

@@ -666,9 +666,12 @@ _STOP_REASONS = {"samplesPerPixel": "all samples", "noiseTarget": "noise target 
 
 
 def _integrator_summary(settings, rstats) -> str:
-    """The integrator that rendered; with integrator = auto, the choice and why."""
+    """The integrator that rendered; with integrator = auto, the choice and why; with combined's
+    automatic share, who takes open media and why."""
     if settings.to_dict()["integrator"] == "auto":
         return "auto: %s (%s)" % (rstats["integrator_used"], rstats["integrator_reason"])
+    if rstats["integrator_reason"]:
+        return "%s (%s)" % (rstats["integrator_used"], rstats["integrator_reason"])
     return rstats["integrator_used"]
 
 
