@@ -1293,8 +1293,8 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
             c.photonsPerPass = 16000;
             c.combinedPhotonShare = share;
             const auto got = means(d, c);
-            std::printf("%s, share %.1f: single %.5f/%.5f multiple %.5f +- %.5f / %.5f +- %.5f emission %.5f/%.5f\n", name.c_str(),
-                        share, got[0].mean, ref[0].mean, got[1].mean, got[1].stderr_, ref[1].mean, ref[1].stderr_, got[2].mean,
+            std::printf("%s, share %.1f: single %.5f +- %.5f/%.5f +- %.5f multiple %.5f +- %.5f / %.5f +- %.5f emission %.5f/%.5f\n", name.c_str(),
+                        share, got[0].mean, got[0].stderr_, ref[0].mean, ref[0].stderr_, got[1].mean, got[1].stderr_, ref[1].mean, ref[1].stderr_, got[2].mean,
                         ref[2].mean);
             const double bias = 0.03 * ref[1].mean;
             for (int k = 0; k < 4; ++k)
