@@ -2,9 +2,10 @@
 """Equal-time RMSE where a point-like light is in view (issue 15, scene 4): a path-traced reference of
 --reference seconds in 8 batches (its own noise estimated from them and removed from every MSE), then
 --seeds renders of --seconds each with the path tracer, the photon map with points and with beams
-(or the integrators of --variants; 80x60 unless --resolution, the scene's settings, 2 threads), and the share of each render's squared error in its worst
-pixel (the light's pixel held most of it before Renderer::lightPixels_), and each variant's image mean
-per channel against the reference's with its standard error over the seeds (the kernel bias).
+(or the integrators of --variants; 80x60 unless --resolution, the scene's settings, 2 threads), the
+share of each render's squared error in its worst pixel (the light's pixel held most of it before
+Renderer::lightPixels_), and each variant's image mean per channel against the reference's with its
+standard error over the seeds (the kernel bias).
 
     python tools/bench_light_pixel.py                        # fog + spot, 320 s reference, ~7 min
     python tools/bench_light_pixel.py --reference 60 --seeds 2

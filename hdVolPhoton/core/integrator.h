@@ -146,7 +146,7 @@ struct RenderSettings {
     double radiusAlpha = 0.7;
     double photonRadiusMfp = 8;
     bool photonBeams = false;
-    double combinedPhotonShare = -1;  ///< -1: auto (combinedShare)
+    double combinedPhotonShare = -1;  ///< -1: automatic (resolved by the Renderer from auto's pilot)
     int stratifiedDims = 516;  // camera + 16 segments of Rng::SegmentDims
     double marchStep = 0;
     bool singleScattering = true;

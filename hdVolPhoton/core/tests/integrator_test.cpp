@@ -866,10 +866,9 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     // with a distant light instead, or ten times denser (optical depth 4) -> the path tracer. Media
     // behind index-matched boundaries count as media in view.
     using I = RenderSettings::Integrator;
-    auto fog = pointLitFog;
     RenderSettings s = smallSettings(I::Auto, 2, 5);
     auto choose = [&](const SceneDesc& d) { return chooseIntegrator(Scene(d), s); };
-    SceneDesc thin = fog(0.2);
+    SceneDesc thin = pointLitFog(0.2);
     IntegratorChoice c = choose(thin);
     EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
     EXPECT_TRUE(c.photonBeams) << c.reason;
@@ -894,7 +893,7 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     SceneDesc sun = thin;
     sun.lights = {makeDistantLight(normalize(Vec3(0.3, -1, 0.2)), 0.0, Spectrum(2.0))};
     EXPECT_EQ(choose(sun).integrator, I::PathTracer) << choose(sun).reason;
-    c = choose(fog(2.0));
+    c = choose(pointLitFog(2.0));
     EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
     EXPECT_FALSE(c.photonBeams);
     EXPECT_EQ(c.reason.find("mean optical depth 0."), std::string::npos) << c.reason;
@@ -1256,8 +1255,9 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
     // Single scattering and volume emission are the path tracer's own estimators in the combined
     // integrator (with the automatic share -1 where auto picks the photon map, single scattering is
     // the photon map's march in open media, unbiased too): they must agree with the path tracer within
-    // the noise alone (4 standard errors over 8 seeds). Multiple scattering mixes the photon gather (weight share) with the continued path
-    // (probability 1 - share): within the noise plus 3% of it for the photon kernel's bias (initial
+    // the noise alone (4 standard errors over 8 seeds). Multiple scattering mixes the photon gather
+    // (weight share) with the continued path (probability 1 - share): within the noise plus 3% of it
+    // for the photon kernel's bias (initial
     // radius 0.05 of 2-unit boxes). The check has teeth: 4 sigma below 8% of the multiple part.
     const Film::Aov aovs[4] = {Film::Single, Film::Multiple, Film::Emission, Film::Beauty};
     uint64_t photonsTraced = 0;  // by the last render of means()
@@ -1286,10 +1286,8 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
             // The point-lit fog is here for the automatic share; intermediate shares are the other scenes'
             // (at 0.5 its continued paths' noise leaves no room for the 8% check below).
             if (share == 0.5 && name.find("point and a sphere") != std::string::npos) continue;
-            if (share < 0 && chooseIntegrator(Scene(d), smallSettings(RenderSettings::Integrator::Combined, 32, 0)).integrator !=
-                                 RenderSettings::Integrator::PhotonMap)
-                continue;
             RenderSettings c = smallSettings(RenderSettings::Integrator::Combined, 32, 0);
+            if (share < 0 && chooseIntegrator(Scene(d), c).integrator != RenderSettings::Integrator::PhotonMap) continue;
             c.photonsPerPass = 16000;
             c.combinedPhotonShare = share;
             const auto got = means(d, c);
