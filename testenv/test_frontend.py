@@ -779,12 +779,15 @@ MEDIUM_CUBE = """
 """
 
 
-@pytest.mark.parametrize("ior,chosen", [("1.3", "combined"), ("1", "pathTracer")])
-def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
+@pytest.mark.parametrize("ior,density,chosen,prefix", [("1.3", 8, "combined", ""), ("1", 8, "pathTracer", ""),
+                                                       ("1", 0.2, "combined", "open media by the photon map (beams): ")])
+def test_integrator_auto_reports_its_choice(tmp_path, ior, density, chosen, prefix):
     """--integrator auto: a cube of dense medium filling the middle of the view, translucent behind an
-    n = 1.3 surface (the combined integrator) or an open medium (ior 1: the path tracer); the stats and the
-    log line say which integrator rendered and why (core chooseIntegrator)."""
-    stage, path = stage_from(tmp_path, MEDIUM_CUBE % ior)
+    n = 1.3 surface (the combined integrator) or an open medium (ior 1: the path tracer), or a cube of
+    thin fog lit by the sphere light alone (combined, whose camera segments in the fog are the photon
+    map's with beams); the stats and the log line say which integrator rendered and why (core
+    chooseIntegrator)."""
+    stage, path = stage_from(tmp_path, (MEDIUM_CUBE % ior).replace("density = 8", "density = %g" % density))
     stats = tmp_path / "s.json"
     r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "1",
                 "--integrator", "auto", "--photons", "2000")
@@ -793,8 +796,9 @@ def test_integrator_auto_reports_its_choice(tmp_path, ior, chosen):
     assert st["settings"]["integrator"] == "auto"
     assert st["render"]["integrator_used"] == chosen
     reason = st["render"]["integrator_reason"]
-    assert reason.startswith("translucent objects cover") and "of the view, open media" in reason, reason
+    assert reason.startswith(prefix + "translucent objects cover") and "of the view, open media" in reason, reason
     assert "auto: %s (%s)" % (chosen, reason) in r.stderr + r.stdout
+    assert (st["render"]["photons_traced"] > 0) == (chosen == "combined"), st["render"]
 
 
 def test_integrator_combined_renders_through_the_cli(tmp_path):

@@ -237,12 +237,19 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     char depthText[96];
     std::snprintf(depthText, sizeof depthText, ", mean optical depth %.2g along them, albedo up to %.2g", meanDepth, albedo);
     if (media > 0) view += depthText;
-    if (media > 0 && thin && pointLit) {
-        IntegratorChoice choice{I::PhotonMap, view + "; optically thin open media lit only by point, spot or sphere lights, "
-                                "where photon beams lead the path tracer"};
-        choice.photonBeams = true;
+    // Where the photon map leads on open media: combined, whose camera segments there are the photon
+    // map's (openMediaByPhotons), measured level with photonMap at equal time (dense cloud 1.00x,
+    // fog + spot 1.02x, atmosphere 0.93x, VDB cloud at 320 x 240 1.00x: README, "Which integrator"),
+    // and whose paths keep MIS at surfaces.
+    auto byPhotons = [&](const std::string& why, bool beams) {
+        IntegratorChoice choice{I::Combined, view + "; " + why};
+        choice.openMediaByPhotons = true;
+        choice.photonBeams = beams;
         return choice;
-    }
+    };
+    if (media > 0 && thin && pointLit)
+        return byPhotons("optically thin open media lit only by point, spot or sphere lights, where photon beams lead the path tracer",
+                         true);
     // Other open media: the photon map's error at equal time falls against the path tracer's as the
     // image grows (each photon serves the camera rays of every pixel near it; the path tracer's
     // samples per pixel fall with the pixel count), the more so the more the light scatters. Measured
@@ -260,14 +267,12 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
         return {I::PathTracer, view + "; opaque surfaces fill most of the view, where the path tracer leads"};
     const double pixels = double(std::max(1, settings.width)) * std::max(1, settings.height);
     std::string size = std::to_string(settings.width) + " x " + std::to_string(settings.height) + " pixels";
-    if (media > 0 && pixels >= SmallImagePixels && (thin || albedo >= HighAlbedo)) {
-        IntegratorChoice choice{I::PhotonMap, view + "; at " + size + " the photon map leads the path tracer in " +
-                                (thin ? "optically thin media" : "media that scatter light many times (high albedo)")};
-        choice.photonBeams = !thin;
-        return choice;
-    }
+    if (media > 0 && pixels >= SmallImagePixels && (thin || albedo >= HighAlbedo))
+        return byPhotons("at " + size + " the photon map leads the path tracer in " +
+                             (thin ? "optically thin media" : "media that scatter light many times (high albedo)"),
+                         !thin);
     if (media > 0 && pixels >= LargeImagePixels && albedo >= MidAlbedo)
-        return {I::PhotonMap, view + "; at " + size + " the photon map leads the path tracer in media of this albedo"};
+        return byPhotons("at " + size + " the photon map leads the path tracer in media of this albedo", false);
     return {I::PathTracer, view + "; the path tracer leads on these open media at " + size};
 }
 
@@ -297,18 +302,19 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     const bool combined = resolved.integrator == RenderSettings::Integrator::Combined;
     bool openMediaSegments = false;
     if (combined && resolved.combinedPhotonShare < 0) {
-        // combinedPhotonShare auto: where auto would render the scene with the photon map, camera
-        // segments in open media are the photon map's (its march's single scattering and its gather,
+        // combinedPhotonShare auto: where auto's pilot finds the photon map leading on open media
+        // (openMediaByPhotons), camera segments in open media are the photon map's (its march's single scattering and its gather,
         // with auto's points or beams); elsewhere the path tracer's paths carry open media (share 0).
         // Surfaces, emission and translucent objects are combined's either way. Share 1 alone (the
         // photons' multiple scattering, the path tracer's single) measured 0.995x the photon map's RMSE
         // on the dense cloud but 2.0x on the atmosphere, where single scattering is most of the light
         // (README, "Which integrator").
         if (!choice) choice = chooseIntegrator(*scene_, settings_);
-        openMediaSegments = choice->integrator == RenderSettings::Integrator::PhotonMap;
+        openMediaSegments = choice->openMediaByPhotons;
         resolved.combinedPhotonShare = openMediaSegments ? 1 : 0;
         resolved.photonBeams |= openMediaSegments && choice->photonBeams;
-        if (settings_.integrator == RenderSettings::Integrator::Combined)  // auto's own reason stands otherwise
+        // auto's own reason stands where it chose combined for translucent objects
+        if (settings_.integrator == RenderSettings::Integrator::Combined || openMediaSegments)
             stats_.integratorReason = std::string(openMediaSegments ? "open media by the photon map" : "open media by the path tracer") +
                                       (openMediaSegments && resolved.photonBeams ? " (beams)" : "") + ": " + choice->reason;
     }

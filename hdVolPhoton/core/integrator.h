@@ -5,10 +5,10 @@
 // |---------------------|--------|------------|--------------|--------------------------------------------------|
 // | integrator          | enum   | pathTracer |              | pathTracer (unbiased), photonMap, combined (the   |
 // |                     |        |            |              | path tracer with the photon map's multiple        |
-// |                     |        |            |              | scattering, combinedPhotonShare), or auto: one of |
-// |                     |        |            |              | pathTracer, combined or photonMap (points or      |
-// |                     |        |            |              | beams) per scene and image size by a pilot        |
-// |                     |        |            |              | (chooseIntegrator)                                |
+// |                     |        |            |              | scattering, combinedPhotonShare), or auto:        |
+// |                     |        |            |              | pathTracer or combined (photons in open media,    |
+// |                     |        |            |              | points or beams, where they lead) per scene and   |
+// |                     |        |            |              | image size by a pilot (chooseIntegrator)          |
 // | width, height       | int    | 640, 360   | pixels       | image size                                        |
 // | samplesPerPixel     | int    | 16         |              | passes; one camera sample per pixel per pass. With|
 // |                     |        |            |              | noiseTarget: the passes every pixel gets before it|
@@ -122,7 +122,7 @@
 namespace volphoton {
 
 struct RenderSettings {
-    /// Auto: pathTracer, photonMap or combined, chosen per scene by a pilot of camera rays (chooseIntegrator).
+    /// Auto: pathTracer or combined, chosen per scene by a pilot of camera rays (chooseIntegrator).
     /// Combined: the path tracer's camera paths with the photon map's estimate of multiple scattering
     /// along their medium segments (PhotonEstimate, integratorBase.h), weighted by combinedPhotonShare.
     enum class Integrator { PathTracer, PhotonMap, Auto, Combined };
@@ -200,7 +200,10 @@ struct IntegratorChoice {
     std::string reason;
     /// Translucent objects in view and a delta light: the path tracer would miss that light inside.
     bool photonsOnly = false;
-    /// The photon map with photon beams (RenderSettings::photonBeams): thin, point-lit open media, and
+    /// The photon map leads the path tracer on the open media in view: the choice is combined, whose
+    /// automatic share (combinedPhotonShare -1) makes their camera segments the photon map's.
+    bool openMediaByPhotons = false;
+    /// Those segments gather photon beams (RenderSettings::photonBeams): thin, point-lit open media, and
     /// high-albedo media in images of 128 x 128 pixels and up.
     bool photonBeams = false;
 };
@@ -216,7 +219,9 @@ struct IntegratorChoice {
 /// the photon map gains on the path tracer as pixels share its photons: from 128 x 128 pixels the
 /// photon map in thin media (points) and in media of albedo >= 0.95 (beams), from 256 x 256 in media
 /// of albedo >= 0.85 (points), unless opaque surfaces fill more than half the view; the path tracer
-/// otherwise (README, "Which integrator").
+/// otherwise (README, "Which integrator"). Where the photon map leads on open media the choice is
+/// combined with openMediaByPhotons: its camera segments there are the photon map's (same estimators,
+/// level with photonMap at equal time) and its paths light surfaces with MIS.
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;

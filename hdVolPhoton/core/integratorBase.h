@@ -255,7 +255,7 @@ public:
 std::unique_ptr<Integrator> makePathTracer(const Scene& scene, const RenderSettings& settings,
                                            const PhotonEstimate* photons = nullptr);
 /// openMediaSegments (integrator = combined): camera segments in open media are the photon map's too
-/// (wholeSegment), as where auto would pick the photon map (the Renderer's automatic share).
+/// (wholeSegment): the automatic share where auto's pilot finds the photon map leading there.
 std::unique_ptr<Integrator> makePhotonMapper(const Scene& scene, const RenderSettings& settings,
                                              std::shared_ptr<PhotonCache> cache = nullptr, bool openMediaSegments = false);
 

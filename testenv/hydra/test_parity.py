@@ -475,24 +475,24 @@ AUTO_CUBE = '''    def Cube "marble" (
 
 
 @pytest.mark.parametrize("translucent,density,size,chosen", [(True, 8, (W, H), "combined"), (False, 8, (W, H), "pathTracer"),
-                                                             (False, 0.2, (W, H), "photonMap"),
-                                                             (False, 8, (168, 112), "photonMap")])
+                                                             (False, 0.2, (W, H), "combined"),
+                                                             (False, 8, (168, 112), "combined")])
 def test_integrator_auto_renders_what_it_chooses_in_both_doors(tmp_path, hydra_env, translucent, density, size, chosen):
     """integrator = auto (core chooseIntegrator): the pilot sees a translucent cube filling the middle
     of the view (a dielectric with a medium inside) and picks the combined integrator, the same cube as an
-    open medium and picks the path tracer at 48 x 32 pixels and the photon map with beams at 168 x 112
-    (albedo 0.99 from 128 x 128 pixels: the image size reaches the pilot through both doors), or it as
-    thin fog (optical depth 0.32 across) lit only by the sphere light and picks the photon map with beams.
-    In each door the auto image is bit-identical to the one rendered with the chosen integrator named
-    (with photonBeams for the photon map), so both doors make the same choice."""
+    open medium and picks the path tracer at 48 x 32 pixels and combined with photon beams in open media
+    at 168 x 112 (albedo 0.99 from 128 x 128 pixels: the image size reaches the pilot through both
+    doors), or it as thin fog (optical depth 0.32 across) lit only by the sphere light and picks
+    combined with photon beams in open media. In each door the auto image is bit-identical to the one
+    rendered with the chosen integrator named (combined's automatic share asks the same pilot), so both
+    doors make the same choice; that combined's photons in open media differ from none at all is the
+    core's IntegratorCombined.TheDefaultShareFollowsAutosPilot."""
     body = AUTO_CUBE % {"ior": "        float volphoton:ior = 1.3\n" if translucent else "", "density": density}
-    beams = ["bool volphoton:photonBeams = 1"] if chosen == "photonMap" else []
     images = {}
     jobs, outs = [], []
     for integrator in ("auto", chosen):
         stage = tmp_path / ("%s.usda" % integrator)
-        stage.write_text(stage_text(body, 1, size=size, settings=['token volphoton:integrator = "%s"' % integrator, PHOTONS]
-                                    + (beams if integrator != "auto" else [])))
+        stage.write_text(stage_text(body, 1, size=size, settings=['token volphoton:integrator = "%s"' % integrator, PHOTONS]))
         for door in ("hydra", "cli"):
             out = str(tmp_path / ("%s.%s.exr" % (integrator, door)))
             outs.append(((integrator, door), out))

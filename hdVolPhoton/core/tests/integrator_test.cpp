@@ -757,7 +757,7 @@ TEST(IntegratorAgreement, SurfacesLitByMediaAndMediaLitThroughSurfaces) {
 
 namespace {
 /// A fog box 2 units across (albedo 0.9, HG 0.3) lit by a point light and a small sphere light: at
-/// sigma_t 0.2 (optical depth 0.4 across) auto picks the photon map with beams at any image size.
+/// sigma_t 0.2 (optical depth 0.4 across) auto gives its open media to photon beams at any image size.
 SceneDesc pointLitFog(double sigmaT) {
     SceneDesc d;
     auto c = MediumCoefficients::fromAlbedo(sigmaT, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
@@ -861,8 +861,9 @@ TEST(IntegratorAuto, ThePilotPicksCombinedForTranslucentObjectsAndThePathTracerF
 
 TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     // chooseIntegrator: a fog box 2 units across (sigma_t 0.2: optical depth 0.4 across) lit by a
-    // point light and a small sphere light -> the photon map with beams, and the Renderer renders
-    // exactly that (bit-identical to photonMap + photonBeams named). The same fog with a dome added,
+    // point light and a small sphere light -> combined with the photon map's beams in open media, and
+    // the Renderer renders exactly that (bit-identical to combined named, whose automatic share asks
+    // the same pilot; the stats say beams). The same fog with a dome added,
     // with a distant light instead, or ten times denser (optical depth 4) -> the path tracer. Media
     // behind index-matched boundaries count as media in view.
     using I = RenderSettings::Integrator;
@@ -870,22 +871,20 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     auto choose = [&](const SceneDesc& d) { return chooseIntegrator(Scene(d), s); };
     SceneDesc thin = pointLitFog(0.2);
     IntegratorChoice c = choose(thin);
-    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+    EXPECT_TRUE(c.openMediaByPhotons) << c.reason;
     EXPECT_TRUE(c.photonBeams) << c.reason;
     EXPECT_NE(c.reason.find("mean optical depth 0."), std::string::npos) << c.reason;  // at most 0.4 on every ray
     EXPECT_NE(c.reason.find("photon beams lead the path tracer"), std::string::npos) << c.reason;
 
     auto scene = std::make_shared<Scene>(thin);
-    Renderer autoRender(scene, s);
-    RenderSettings named = smallSettings(I::PhotonMap, 2, 5), points = named;
-    named.photonBeams = true;
-    Renderer beamRender(scene, named), pointRender(scene, points);
+    Renderer autoRender(scene, s), combinedRender(scene, smallSettings(I::Combined, 2, 5));
     autoRender.render();
-    beamRender.render();
-    pointRender.render();
-    EXPECT_EQ(autoRender.stats().integratorUsed, "photonMap");
-    EXPECT_EQ(autoRender.film().resolveRgb(Film::Beauty), beamRender.film().resolveRgb(Film::Beauty));
-    EXPECT_NE(autoRender.film().resolveRgb(Film::Beauty), pointRender.film().resolveRgb(Film::Beauty));
+    combinedRender.render();
+    EXPECT_EQ(autoRender.stats().integratorUsed, "combined");
+    EXPECT_EQ(autoRender.stats().integratorReason, "open media by the photon map (beams): " + c.reason);
+    EXPECT_EQ(autoRender.film().resolveRgb(Film::Beauty), combinedRender.film().resolveRgb(Film::Beauty));
+    EXPECT_GT(autoRender.stats().photonsTraced, 0u);
 
     SceneDesc domeToo = thin;
     domeToo.lights.push_back(makeDomeLight(Spectrum(0.1)));
@@ -896,6 +895,7 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     c = choose(pointLitFog(2.0));
     EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
     EXPECT_FALSE(c.photonBeams);
+    EXPECT_FALSE(c.openMediaByPhotons);
     EXPECT_EQ(c.reason.find("mean optical depth 0."), std::string::npos) << c.reason;
 
     // The same fog bounded by a mesh (an index-matched boundary, as a UsdGeom Cube with the medium
@@ -909,7 +909,8 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     bounded.meshes.push_back(boundary);
     bounded.instances.push_back({0, Affine()});
     c = choose(bounded);
-    EXPECT_EQ(c.integrator, I::PhotonMap) << c.reason;
+    EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+    EXPECT_TRUE(c.openMediaByPhotons) << c.reason;
     EXPECT_NE(c.reason.find("open media 100%"), std::string::npos) << c.reason;
     SceneDesc behind = bounded;
     behind.media.push_back(std::make_shared<HomogeneousMedium>(
@@ -923,6 +924,7 @@ TEST(IntegratorAuto, ThinOpenMediaLitOnlyByPointLikeLightsGetPhotonBeams) {
     behind.instances.push_back({1, Affine()});
     c = choose(behind);
     EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+    EXPECT_FALSE(c.openMediaByPhotons) << c.reason;
     EXPECT_EQ(c.reason.find("translucent objects cover 0%"), std::string::npos) << c.reason;
 }
 
@@ -931,7 +933,8 @@ TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
     // photon map gains on the path tracer as the image grows (pixels share its photons): thin media
     // and albedo >= 0.95 get it from 128 x 128 pixels (beams where the medium is not thin), albedo
     // >= 0.85 from 256 x 256 (points), lower albedo keeps the path tracer (benchmark scenes 1, 2, 3
-    // and 5 at four sizes, README "Which integrator"); so does a view mostly of opaque surfaces.
+    // and 5 at four sizes, README "Which integrator"); so does a view mostly of opaque surfaces. The
+    // photon map comes as combined, whose camera segments in open media are then the photon map's.
     using I = RenderSettings::Integrator;
     auto box = [](double sigmaT, double albedo) {
         SceneDesc d;
@@ -954,13 +957,14 @@ TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
         I expected;
         bool beams;
     };
-    for (const Case& k : {Case{0.2, 0.9, 64, 48, I::PathTracer, false}, Case{0.2, 0.9, 160, 120, I::PhotonMap, false},
-                          Case{2.0, 0.99, 64, 48, I::PathTracer, false}, Case{2.0, 0.99, 160, 120, I::PhotonMap, true},
-                          Case{2.0, 0.9, 160, 120, I::PathTracer, false}, Case{2.0, 0.9, 320, 240, I::PhotonMap, false},
+    for (const Case& k : {Case{0.2, 0.9, 64, 48, I::PathTracer, false}, Case{0.2, 0.9, 160, 120, I::Combined, false},
+                          Case{2.0, 0.99, 64, 48, I::PathTracer, false}, Case{2.0, 0.99, 160, 120, I::Combined, true},
+                          Case{2.0, 0.9, 160, 120, I::PathTracer, false}, Case{2.0, 0.9, 320, 240, I::Combined, false},
                           Case{2.0, 0.8, 640, 480, I::PathTracer, false}}) {
         IntegratorChoice c = choose(box(k.sigmaT, k.albedo), k.w, k.h);
         EXPECT_EQ(c.integrator, k.expected) << k.sigmaT << " " << k.albedo << " " << k.w << ": " << c.reason;
         EXPECT_EQ(c.photonBeams, k.beams) << k.sigmaT << " " << k.albedo << " " << k.w << ": " << c.reason;
+        EXPECT_EQ(c.openMediaByPhotons, k.expected == I::Combined) << k.sigmaT << " " << k.albedo << " " << k.w;
         EXPECT_NE(c.reason.find(std::to_string(k.w) + " x " + std::to_string(k.h) + " pixels"), std::string::npos) << c.reason;
     }
     EXPECT_NE(choose(box(2.0, 0.99), 160, 120).reason.find("albedo up to 0.99"), std::string::npos);
@@ -979,7 +983,8 @@ TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
     s.height = 120;
     s.photonsPerPass = 1000;
     Renderer r(std::make_shared<Scene>(box(2.0, 0.99)), s);
-    EXPECT_EQ(r.stats().integratorUsed, "photonMap");
+    EXPECT_EQ(r.stats().integratorUsed, "combined");
+    EXPECT_EQ(r.stats().integratorReason.rfind("open media by the photon map (beams): ", 0), 0u) << r.stats().integratorReason;
 }
 
 TEST(IntegratorAovs, BeautyIsTheSumOfTheSplit) {
@@ -1207,7 +1212,7 @@ TEST(IntegratorCombined, PhotonShareZeroIsThePathTracerExactly) {
 }
 
 TEST(IntegratorCombined, TheDefaultShareFollowsAutosPilot) {
-    // combinedPhotonShare -1 (the default): where chooseIntegrator picks the photon map, camera
+    // combinedPhotonShare -1 (the default): where chooseIntegrator finds photons leading, camera
     // segments in open media are the photon map's (its march's single scattering, its gather with
     // auto's points or beams); elsewhere share 0, bit for bit the render with share 0 named. The stats
     // say which and why. The scenes hold both cases (the point-lit fog gets beams; the others keep the
@@ -1220,7 +1225,7 @@ TEST(IntegratorCombined, TheDefaultShareFollowsAutosPilot) {
         RenderSettings byDefault = smallSettings(I::Combined, 4, 7), named = byDefault;
         ASSERT_EQ(byDefault.combinedPhotonShare, -1.0);
         IntegratorChoice choice = chooseIntegrator(*scene, byDefault);
-        const bool photons = choice.integrator == I::PhotonMap;
+        const bool photons = choice.openMediaByPhotons;
         named.combinedPhotonShare = photons ? 1 : 0;
         named.photonBeams = photons && choice.photonBeams;
         Renderer a(scene, byDefault), b(scene, named);
@@ -1253,7 +1258,7 @@ TEST(IntegratorCombined, TheDefaultShareFollowsAutosPilot) {
 
 TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
     // Single scattering and volume emission are the path tracer's own estimators in the combined
-    // integrator (with the automatic share -1 where auto picks the photon map, single scattering is
+    // integrator (with the automatic share -1 where auto finds photons leading, single scattering is
     // the photon map's march in open media, unbiased too): they must agree with the path tracer within
     // the noise alone (4 standard errors over 8 seeds). Multiple scattering mixes the photon gather
     // (weight share) with the continued path (probability 1 - share): within the noise plus 3% of it
@@ -1287,7 +1292,7 @@ TEST(IntegratorCombined, AgreesWithThePathTracerPerAovAtEveryShare) {
             // (at 0.5 its continued paths' noise leaves no room for the 8% check below).
             if (share == 0.5 && name.find("point and a sphere") != std::string::npos) continue;
             RenderSettings c = smallSettings(RenderSettings::Integrator::Combined, 32, 0);
-            if (share < 0 && chooseIntegrator(Scene(d), c).integrator != RenderSettings::Integrator::PhotonMap) continue;
+            if (share < 0 && !chooseIntegrator(Scene(d), c).openMediaByPhotons) continue;
             c.photonsPerPass = 16000;
             c.combinedPhotonShare = share;
             const auto got = means(d, c);

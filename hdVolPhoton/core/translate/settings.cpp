@@ -49,8 +49,8 @@ std::vector<SettingInfo> makeTable() {
                  "volphoton:integrator", "Integrator", "",
                  "pathTracer (unbiased volumetric path tracer), photonMap (single-scattering march + volume photon map), "
                  "combined (path-traced camera paths with the photon map's multiple scattering) "
-                 "or auto (pathTracer, combined, or photonMap with points or beams per scene and image size from a pilot of "
-                 "camera rays; the stats say which and why)",
+                 "or auto (pathTracer, or combined with photon points or beams in open media where they lead, per scene "
+                 "and image size from a pilot of camera rays; the stats say which and why)",
                  [](const RS& s) { return AttrValue(integratorName(s.integrator)); },
                  [](RS& s, const AttrValue& v) { parseIntegrator(std::get<std::string>(v), &s.integrator); }});
     t.push_back(intSetting("samplesPerPixel", 1, Big, "--spp", "convergedSamplesPerPixel", "Samples per pixel", "",
@@ -90,8 +90,9 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(doubleSetting("combinedPhotonShare", -1, 1, "", "Combined: photon share (-1: auto)", "",
                               "combined: the photon map's share of the light scattered more than once at a camera "
                               "path's vertex in open media (1 inside translucent objects); the path goes on for the "
-                              "rest with probability 1 - share (0: the path tracer's in open media; -1: where auto would "
-                              "pick the photon map, the photon map's single and multiple scattering in open media, else 0)",
+                              "rest with probability 1 - share (0: the path tracer's in open media; -1: where auto's pilot "
+                              "finds the photon map leading there, its single and multiple scattering in open media, "
+                              "else 0)",
                               &RS::combinedPhotonShare));
     t.push_back(boolSetting("photonBeams", "", "Photon beams",
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points where media are "
