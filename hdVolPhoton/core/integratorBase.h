@@ -153,8 +153,16 @@ protected:
     static constexpr size_t AllLightsMax = 4;
     static_assert(2 * AllLightsMax <= Rng::eventWidth(Rng::Event::Light), "each light of an all-lights vertex has its own sampler pair");
     bool surfaceSamplesAllLights() const { return scene_.lights().size() <= AllLightsMax; }
-    /// Probability with which a lambertian vertex's next-event estimation chooses light i (for MIS).
-    double surfaceLightPickProb(int light) const { return surfaceSamplesAllLights() ? 1.0 : lightPickProb(light); }
+    /// A lambertian vertex with MIS leaves a constant dome to its cosine-sampled bounce alone, as
+    /// pbrt-v4's UniformInfiniteLight::SampleLi does when allowIncompletePDF: cosine sampling is
+    /// proportional to that light's unoccluded integrand, while sampling the light's sphere puts half
+    /// its samples below the horizon and adds the rest's variance (tools/bench/README.md, "Constant
+    /// domes at surfaces").
+    bool surfaceLeavesToBounce(int light) const { return scene_.lights()[light]->isConstantDome(); }
+    /// Probability with which a lambertian vertex's next-event estimation with MIS chooses light i.
+    double surfaceLightPickProb(int light) const {
+        return surfaceLeavesToBounce(light) ? 0.0 : surfaceSamplesAllLights() ? 1.0 : lightPickProb(light);
+    }
     /// The nearest light with extent the ray meets in (tFrom, tMax); lights at infinity (dome, distant
     /// lights with extent) only when tMax is infinite, and then the first of them (lightsAtInfinity()
     /// gives them all). cameraRay: the ray is still the camera's own (first segment), so a dome hidden
@@ -178,7 +186,8 @@ protected:
                                  double tMin = 0) const;
     /// Next-event estimate at a lambertian hit for a path arriving along ray.d: albedo/pi cos T Li / pdf
     /// for every light (surfaceSamplesAllLights) or one light picked by power. With `mis`, lights with extent are weighted by the power
-    /// heuristic against cosine sampling (the path tracer); without, light sampling stands alone.
+    /// heuristic against cosine sampling (the path tracer), and a constant dome is left to the bounce
+    /// (surfaceLeavesToBounce); without, light sampling stands alone.
     Spectrum directAtLambertian(const Ray& ray, const SurfaceHit& hit, const MediumStack& stack, Rng& rng, bool mis) const;
     /// Radiance an emissive lambertian surface sends back along ray.d (from its front face, the side
     /// hit.ng points to), else black. The camera paths add it at their hits (weighted: emissive

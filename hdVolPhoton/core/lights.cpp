@@ -465,6 +465,7 @@ public:
         *pdf = sinTheta > 0 ? mapPdf / (2 * Pi * Pi * sinTheta) : 0.0;
         return normalize(toWorld_.vector(d));
     }
+    bool isConstantDome() const override { return img_.width == 0; }
     LightSample sample(const Vec3&, double u1, double u2) const override {
         LightSample s;
         s.wi = sampleDirection(u1, u2, &s.pdf);

@@ -75,6 +75,8 @@ public:
     virtual bool isGeometry() const { return false; }
     /// The environment (dome) light: RenderSettings::domeVisibleToCamera may hide it from camera rays.
     virtual bool isDome() const { return false; }
+    /// A dome of one radiance in every direction (no texture).
+    virtual bool isConstantDome() const { return false; }
     /// Position of a point (or point spot) light, for equiangular sampling; nullopt for others.
     virtual std::optional<Vec3> pointPosition() const { return std::nullopt; }
     /// Centre towards which equiangular sampling aims (point, spot and sphere lights); nullopt for others.

@@ -35,6 +35,7 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
         Spectrum sum;
         for (size_t i = 0; i < scene_.lights().size(); ++i) {
             const LightPtr& light = scene_.lights()[i];
+            if (mis && surfaceLeavesToBounce(static_cast<int>(i))) continue;
             rng.lightPair(static_cast<int>(i));
             auto [u1, u2] = rng.uniform2();
             sum += estimate(light->sample(hit.p, u1, u2), 1.0);
@@ -43,7 +44,7 @@ Spectrum Integrator::directAtLambertian(const Ray& ray, const SurfaceHit& hit, c
     }
     rng.event(Rng::Event::Light);
     DirectSample ds = sampleDirect(hit.p, rng);
-    return ds.light >= 0 ? estimate(ds.ls, ds.pickProb) : Spectrum();
+    return ds.light >= 0 && !(mis && surfaceLeavesToBounce(ds.light)) ? estimate(ds.ls, ds.pickProb) : Spectrum();
 }
 
 SurfaceScatter Integrator::scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng,

@@ -583,6 +583,55 @@ TEST(SceneLights, EveryLightOrOnePickedAtSurfacesGivesTheExactDirectIrradiance) 
     }
 }
 
+TEST(SceneLights, AConstantDomeIsLeftToTheLambertianBounce) {
+    // A lambertian floor (albedo 0.5) under a constant dome of radiance 1: the path tracer's vertex
+    // leaves the dome to its cosine-sampled bounce (surfaceLeavesToBounce), whose density is
+    // proportional to the dome's unoccluded integrand, so every sample of the open floor is exactly
+    // albedo x 1 (sampling the dome's sphere, as before, gave each sample its own value). Next to a
+    // black wall of height h at distance a, infinite along z, the floor sees the dome except the
+    // wall's cosine-weighted share 1/2 (1 - a / sqrt(a^2 + h^2)) (a wall infinite along z blocks the
+    // directions whose angle from the normal, in the plane across the wall, lies in [pi/2 - atan(h/a),
+    // pi/2], whose cosine-weighted share is (sin(pi/2) - sin(pi/2 - atan(h/a))) / 2): the mean must
+    // match it with every light sampled and with one picked of six by power (the other five send
+    // nothing up), each within 4 standard errors.
+    auto floorScene = [](bool wall, int extraLights) {
+        SceneDesc d;
+        MeshDesc floor;
+        floor.name = "floor";
+        floor.points = {Vec3(-20, 0, -20), Vec3(20, 0, -20), Vec3(20, 0, 20), Vec3(-20, 0, 20)};
+        floor.indices = {0, 2, 1, 0, 3, 2};
+        d.meshes.push_back(floor);
+        d.instances.push_back({0, Affine()});
+        if (wall) {
+            MeshDesc w;
+            w.name = "wall";
+            w.points = {Vec3(1, 0, -400), Vec3(1, 0, 400), Vec3(1, 1, 400), Vec3(1, 1, -400)};
+            w.indices = {0, 1, 2, 0, 2, 3};
+            w.material.albedo = Spectrum(0.0);
+            d.meshes.push_back(w);
+            d.instances.push_back({1, Affine()});
+        }
+        d.lights.push_back(makeDomeLight(Spectrum(1.0)));
+        for (int i = 0; i < extraLights; ++i) d.lights.push_back(makeDistantLight(Vec3(0, 1, 0), 0.0, Spectrum(0.01)));
+        d.camera = test::lookAt(Vec3(0, 0.5, 0), Vec3(0, 0, 0));
+        d.camera.projection = CameraDesc::Projection::Orthographic;
+        d.camera.orthoWidth = 0.01;
+        return d;
+    };
+    RenderSettings s = test::smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+    s.width = s.height = 4;
+    auto beauty = [](const Film& f) { return test::aovMean(f, Film::Beauty); };
+    auto open = test::imageMean(floorScene(false, 0), s, beauty);
+    EXPECT_NEAR(open.mean, 0.5, 1e-9);
+    EXPECT_LT(open.stderr_, 1e-9) << "the open floor's samples differ";
+    const double expected = 0.5 * (1 - 0.5 * (1 - 1 / std::sqrt(2.0)));
+    for (int extraLights : {0, 5}) {
+        auto m = test::imageMean(floorScene(true, extraLights), s, beauty);
+        EXPECT_NEAR(m.mean, expected, 4 * m.stderr_) << extraLights << " extra lights, +- " << m.stderr_;
+        EXPECT_LT(4 * m.stderr_, 0.01 * expected) << extraLights << " extra lights, mean " << m.mean;  // resolves a 1% bias
+    }
+}
+
 TEST(Camera, ProjectInvertsGenerateRay) {
     // project() gives back the image position a ray was generated through (perspective and
     // orthographic, a non-square image, a scaled and rotated camera), and refuses points behind the
