@@ -23,13 +23,22 @@ Integrator::Integrator(const Scene& scene, const RenderSettings& settings) : sce
     cameraStack_ = scene.stackAt(Camera(scene.desc().camera, 1, 1).position());
 }
 
-DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng) const {
+DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng, const PhaseAt* phase) const {
     DirectSample d;
     if (!lightDist_.size()) return d;
     size_t i = lightDist_.sampleDiscrete(rng.uniform(), &d.pickProb);
     auto [u1, u2] = rng.uniform2();
     d.light = static_cast<int>(i);
-    d.ls = scene_.lights()[i]->sample(p, u1, u2);
+    const Light& light = *scene_.lights()[i];
+    if (phase && mediumSamplesDomeByPhase(d.light)) {
+        d.alongPhase = true;
+        d.ls.wi = phase->mp.sampleScatter(phase->d, rng.uniform(), u1, u2);
+        d.ls.pdf = phase->mp.scatterPdf(dot(phase->d, d.ls.wi));
+        double domePdf;
+        if (!light.intersect({p, d.ls.wi}, Infinity, &d.ls.dist, &d.ls.Li, &domePdf)) d.ls.pdf = 0;
+        return d;
+    }
+    d.ls = light.sample(p, u1, u2);
     return d;
 }
 

@@ -169,7 +169,8 @@ public:
                 Vec3 p = scatter.p;
                 // Next-event estimation (none inside a dielectric that no shadow ray can leave).
                 rng.event(Rng::Event::Light);
-                DirectSample ds = scene_.sealedFromLights(stack) ? DirectSample{} : sampleDirect(p, rng);
+                PhaseAt phase{mp, ray.d};
+                DirectSample ds = scene_.sealedFromLights(stack) ? DirectSample{} : sampleDirect(p, rng, &phase);
                 if (ds.light >= 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack()) {
                     double cosTheta = dot(ray.d, ds.ls.wi);
                     Spectrum f = mp.scatterKernel(cosTheta);
@@ -225,6 +226,9 @@ public:
             if (ahead.reachesLight()) {
                 auto addLight = [&](int light, const Spectrum& Le, double lightPdf) {
                     double pick = prevSurface ? surfaceLightPickProb(light) : lightPickProb(light);
+                    // A constant dome after a medium vertex: that vertex sampled it by its phase
+                    // function, whose density in this direction is prevPdf (mediumSamplesDomeByPhase).
+                    if (!prevSurface && mediumSamplesDomeByPhase(light)) lightPdf = prevPdf;
                     double w = specular ? 1.0 : powerHeuristic(prevPdf, pick * lightPdf);
                     add(beta * Le * w, lightWasSingle);
                 };
