@@ -312,8 +312,9 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     bool openMediaSegments = false;
     if (combined && resolved.combinedPhotonShare < 0) {
         // combinedPhotonShare auto: where auto's pilot finds the photon map leading on open media
-        // (openMediaByPhotons), camera segments in open media are the photon map's (its march's single scattering and its gather,
-        // with auto's points or beams); elsewhere the path tracer's paths carry open media (share 0).
+        // (openMediaByPhotons), camera segments in open media are the photon map's (its march's single
+        // scattering and its gather, with auto's points or beams); elsewhere the path tracer's paths
+        // carry open media (share 0).
         // Surfaces, emission and translucent objects are combined's either way. Share 1 alone (the
         // photons' multiple scattering, the path tracer's single) measured 0.995x the photon map's RMSE
         // on the dense cloud but 2.0x on the atmosphere, where single scattering is most of the light

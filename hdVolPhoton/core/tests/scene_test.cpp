@@ -550,6 +550,24 @@ TEST(SceneLights, DielectricsWithNoLightInsideAreSealedFromNextEventEstimation) 
     EXPECT_FALSE(sealed(*scene(far, true), 0));  // an emissive mesh inside is a light inside
 }
 
+namespace {
+/// A lambertian floor (albedo 0.5) 40 units wide at y = 0, seen straight down at the origin by a
+/// 0.01-unit-wide orthographic camera; no lights.
+SceneDesc floorSeenFromAbove() {
+    SceneDesc d;
+    MeshDesc floor;
+    floor.name = "floor";
+    floor.points = {Vec3(-20, 0, -20), Vec3(20, 0, -20), Vec3(20, 0, 20), Vec3(-20, 0, 20)};
+    floor.indices = {0, 2, 1, 0, 3, 2};
+    d.meshes.push_back(floor);
+    d.instances.push_back({0, Affine()});
+    d.camera = test::lookAt(Vec3(0, 0.5, 0), Vec3(0, 0, 0));
+    d.camera.projection = CameraDesc::Projection::Orthographic;
+    d.camera.orthoWidth = 0.01;
+    return d;
+}
+}  // namespace
+
 TEST(SceneLights, EveryLightOrOnePickedAtSurfacesGivesTheExactDirectIrradiance) {
     // A lambertian floor (albedo 0.5) under two spherical lights, direct light only: the radiance
     // leaving the floor at the origin is albedo/pi x sum of pi L (r/d)^2 cos(theta) (a sphere wholly
@@ -559,20 +577,11 @@ TEST(SceneLights, EveryLightOrOnePickedAtSurfacesGivesTheExactDirectIrradiance) 
     // hits with the pick probability of the vertex they came from (the power-heuristic pick there:
     // +14.6%).
     for (int extraLights : {0, 3}) {
-        SceneDesc d;
-        MeshDesc floor;
-        floor.name = "floor";
-        floor.points = {Vec3(-20, 0, -20), Vec3(20, 0, -20), Vec3(20, 0, 20), Vec3(-20, 0, 20)};
-        floor.indices = {0, 2, 1, 0, 3, 2};
-        d.meshes.push_back(floor);
-        d.instances.push_back({0, Affine()});
+        SceneDesc d = floorSeenFromAbove();
         // Large lights, so that cosine sampling finds them often and the MIS weights matter.
         d.lights.push_back(makeSphereLight(Vec3(0, 3, 0), 2.0, Spectrum(1.0)));
         d.lights.push_back(makeSphereLight(Vec3(4, 3, 0), 1.5, Spectrum(1.0)));
         for (int i = 0; i < extraLights; ++i) d.lights.push_back(makeDistantLight(Vec3(0, 1, 0), 0.0, Spectrum(0.01)));
-        d.camera = test::lookAt(Vec3(0, 0.5, 0), Vec3(0, 0, 0));
-        d.camera.projection = CameraDesc::Projection::Orthographic;
-        d.camera.orthoWidth = 0.01;
         RenderSettings s = test::smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
         s.width = s.height = 4;
         s.maxDepth = 1;
@@ -595,13 +604,7 @@ TEST(SceneLights, AConstantDomeIsLeftToTheLambertianBounce) {
     // match it with every light sampled and with one picked of six by power (the other five send
     // nothing up), each within 4 standard errors.
     auto floorScene = [](bool wall, int extraLights) {
-        SceneDesc d;
-        MeshDesc floor;
-        floor.name = "floor";
-        floor.points = {Vec3(-20, 0, -20), Vec3(20, 0, -20), Vec3(20, 0, 20), Vec3(-20, 0, 20)};
-        floor.indices = {0, 2, 1, 0, 3, 2};
-        d.meshes.push_back(floor);
-        d.instances.push_back({0, Affine()});
+        SceneDesc d = floorSeenFromAbove();
         if (wall) {
             MeshDesc w;
             w.name = "wall";
@@ -613,9 +616,6 @@ TEST(SceneLights, AConstantDomeIsLeftToTheLambertianBounce) {
         }
         d.lights.push_back(makeDomeLight(Spectrum(1.0)));
         for (int i = 0; i < extraLights; ++i) d.lights.push_back(makeDistantLight(Vec3(0, 1, 0), 0.0, Spectrum(0.01)));
-        d.camera = test::lookAt(Vec3(0, 0.5, 0), Vec3(0, 0, 0));
-        d.camera.projection = CameraDesc::Projection::Orthographic;
-        d.camera.orthoWidth = 0.01;
         return d;
     };
     RenderSettings s = test::smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
