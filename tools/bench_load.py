@@ -12,11 +12,12 @@ BENCH = os.path.join(REPO, "testenv", "bench")
 
 
 def load_bench_scene(name, width, height):
-    """(RenderSettingsInfo, TranslatedScene) of benchmark scene `name` at its earliest time."""
+    """(RenderSettingsInfo, TranslatedScene) of benchmark scene `name` (or of the .usda file it names)
+    at its earliest time."""
     vdb = os.path.join(BENCH, "cloud.vdb")
     if not os.path.exists(vdb):
         _core.write_procedural_cloud_vdb(vdb, 64, 1.0 / 64, 1)
-    stage = Usd.Stage.Open(os.path.join(BENCH, name + ".usda"))
+    stage = Usd.Stage.Open(name if name.endswith(".usda") else os.path.join(BENCH, name + ".usda"))
     rs = usdscene.read_render_settings(stage)
     tr = usdscene.translate(stage, Usd.TimeCode.EarliestTime(), width, height, rs.camera_path, rs.conform_policy)
     return rs, tr

@@ -218,7 +218,7 @@ struct IntegratorChoice {
 /// (point, spot, sphere: fog + spot, benchmark scene 4). Other open media by the image's size, since
 /// the photon map gains on the path tracer as pixels share its photons: from 128 x 128 pixels the
 /// photon map in thin media (points) and in media of albedo >= 0.95 (beams), from 256 x 256 in media
-/// of albedo >= 0.85 (points), unless opaque surfaces fill more than half the view; the path tracer
+/// of albedo >= 0.85 (points), whatever opaque surfaces fill the rest of the view; the path tracer
 /// otherwise (README, "Which integrator"). Where the photon map leads on open media the choice is
 /// combined with openMediaByPhotons: its camera segments there are the photon map's (same estimators,
 /// level with photonMap at equal time) and its paths light surfaces with MIS.

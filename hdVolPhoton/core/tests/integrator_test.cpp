@@ -979,8 +979,9 @@ TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
     // photon map gains on the path tracer as the image grows (pixels share its photons): thin media
     // and albedo >= 0.95 get it from 128 x 128 pixels (beams where the medium is not thin), albedo
     // >= 0.85 from 256 x 256 (points), lower albedo keeps the path tracer (benchmark scenes 1, 2, 3
-    // and 5 at four sizes, README "Which integrator"); so does a view mostly of opaque surfaces. The
-    // photon map comes as combined, whose camera segments in open media are then the photon map's.
+    // and 5 at four sizes, README "Which integrator"). The photon map comes as combined, whose camera
+    // segments in open media are then the photon map's and whose paths light surfaces with MIS, so a
+    // wall filling the view behind the medium changes nothing.
     using I = RenderSettings::Integrator;
     auto box = [](double sigmaT, double albedo) {
         SceneDesc d;
@@ -1014,13 +1015,15 @@ TEST(IntegratorAuto, OpenMediaGetThePhotonMapAsTheImageGrows) {
         EXPECT_NE(c.reason.find(std::to_string(k.w) + " x " + std::to_string(k.h) + " pixels"), std::string::npos) << c.reason;
     }
     EXPECT_NE(choose(box(2.0, 0.99), 160, 120).reason.find("albedo up to 0.99"), std::string::npos);
-    // A wall behind the medium filling the view: opaque surfaces, where the path tracer's MIS leads.
+    // A wall behind the medium filling the view: the same choice as without it.
     for (double sigmaT : {0.2, 2.0}) {
         SceneDesc walled = box(sigmaT, 0.99);
         walled.meshes.push_back(test::boxMesh("wall", Vec3(-5, -5, -3), Vec3(5, 5, -2.5)));
         walled.instances.push_back({0, Affine()});
-        IntegratorChoice c = choose(walled, 640, 480);
-        EXPECT_EQ(c.integrator, I::PathTracer) << c.reason;
+        IntegratorChoice c = choose(walled, 640, 480), bare = choose(box(sigmaT, 0.99), 640, 480);
+        EXPECT_EQ(c.integrator, I::Combined) << c.reason;
+        EXPECT_TRUE(c.openMediaByPhotons) << c.reason;
+        EXPECT_EQ(c.photonBeams, bare.photonBeams) << c.reason;
         EXPECT_NE(c.reason.find("opaque surfaces 100%"), std::string::npos) << c.reason;
     }
     // The Renderer renders the choice.
