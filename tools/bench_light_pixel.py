@@ -73,6 +73,7 @@ def main():
     ref_var = (batches.var(0, ddof=1) / len(batches)).mean()
     print("%s: reference %s, its noise RMSE %.6f (removed below); %s" % (
         a.scene, a.load or "%g s" % a.reference, np.sqrt(ref_var), _core.__file__))
+    ref_means = batches.reshape(len(batches), -1, 3).mean(1)  # per batch and channel
     for label in a.variants.split(","):
         integrator, beams, share = VARIANTS[label]
         mse, worst, means = [], [], []
@@ -87,7 +88,6 @@ def main():
             " ".join("%.0f%%" % (100 * w) for w in worst)), flush=True)
         # The image mean per channel against the reference's: the kernel bias shows here when it
         # exceeds the standard error over the seeds (combined with the reference's over its batches).
-        ref_means = batches.reshape(len(batches), -1, 3).mean(1)
         rel = np.mean(means, 0) / ref_means.mean(0) - 1
         se = np.hypot(np.std(means, 0, ddof=1) / np.sqrt(a.seeds), ref_means.std(0, ddof=1) / np.sqrt(len(batches))) / ref_means.mean(0)
         print("    image mean vs reference per channel: %s" % ", ".join(

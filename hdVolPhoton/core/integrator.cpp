@@ -31,7 +31,6 @@ DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng, const PhaseAt* ph
     d.light = static_cast<int>(i);
     const Light& light = *scene_.lights()[i];
     if (phase && mediumSamplesDomeByPhase(d.light)) {
-        d.alongPhase = true;
         d.ls.wi = phase->mp.sampleScatter(phase->d, rng.uniform(), u1, u2);
         d.ls.pdf = phase->mp.scatterPdf(dot(phase->d, d.ls.wi));
         double domePdf;

@@ -17,9 +17,6 @@ struct DirectSample {
     LightSample ls;
     double pickProb = 0;
     int light = -1;
-    /// ls.wi was drawn from the vertex's phase function, not from the light (a constant dome at a
-    /// medium vertex: Integrator::mediumSamplesDomeByPhase); ls.pdf is that density.
-    bool alongPhase = false;
 };
 
 /// Russian roulette past DeepRouletteDepth events: a path survives each further event with
@@ -149,7 +146,7 @@ public:
 protected:
     /// One light picked by power (pick probability, then the light's own pair of draws). With `phase`
     /// (a medium vertex: its coefficients, reached along direction d) a constant dome's direction is
-    /// drawn from the phase function instead (one more draw, the lobe): DirectSample::alongPhase.
+    /// drawn from the phase function instead (one more draw, the lobe; ls.pdf is the phase density).
     struct PhaseAt {
         const MediumProperties& mp;
         Vec3 d;
