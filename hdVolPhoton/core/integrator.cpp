@@ -114,14 +114,20 @@ double Integrator::leakDistance(const MediumStack& stack, const Ray& ray) const 
     return scene_.exitDistance(mesh, ray);
 }
 
-PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay) const {
+PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay,
+                                    double within) const {
     PathSegment seg;
-    seg.hasHit = scene_.intersect(path.ray, path.tMin, path.tMax, &seg.hit);
-    seg.tEnd = seg.hasHit ? seg.hit.t : path.tMax;
-    seg.hasLight = hitLight(path.ray, path.lightsFrom, seg.hasHit ? seg.tEnd : Infinity, &seg.tLight, &seg.lightLe, &seg.lightPdf, &seg.light,
-                            cameraRay);
+    const bool limited = within < path.tMax;
+    const double tMax = limited ? within : path.tMax;
+    seg.hasHit = scene_.intersect(path.ray, path.tMin, tMax, &seg.hit);
+    seg.tEnd = seg.hasHit ? seg.hit.t : tMax;
+    seg.hasLight = hitLight(path.ray, path.lightsFrom, seg.hasHit || limited ? seg.tEnd : Infinity, &seg.tLight, &seg.lightLe,
+                            &seg.lightPdf, &seg.light, cameraRay);
     if (seg.hasLight && !std::isinf(seg.tLight)) seg.tEnd = std::min(seg.tEnd, seg.tLight);
-    seg.leakExit = seg.hasHit ? Infinity : leakDistance(stack, path.ray);
+    // A limited search that meets nothing inside a closed mesh is no sign of a crossing missed
+    // (leakDistance): the origin is inside, and so is everything up to `within`.
+    const bool closedAround = stack.innermost() >= 0 && scene_.meshClosed(stack.innermost());
+    seg.leakExit = seg.hasHit || (limited && closedAround) ? Infinity : leakDistance(stack, path.ray);
     if (seg.leakExit < seg.tEnd) seg.tEnd = seg.leakExit;
     return seg;
 }

@@ -216,8 +216,12 @@ protected:
     /// Scatter at a surface hit. radianceMode: camera paths (divide by eta^2 on refraction); false for photons.
     SurfaceScatter scatterSurface(const Ray& ray, const SurfaceHit& hit, MediumStack& stack, Rng& rng, bool radianceMode) const;
     /// The surface, light and hole a camera path meets next along path.ray (surfaces in [tMin, tMax];
-    /// lights up to the surface, or to infinity without one). cameraRay as in hitLight().
-    PathSegment nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay) const;
+    /// lights up to the surface, or to infinity without one). cameraRay as in hitLight(). With a
+    /// finite `within`, everything is searched up to it only (the segment ends there when nothing is
+    /// met: tEnd == within): the path tracer's flight sampled before the search (pathTracer.cpp,
+    /// EarlyFlight), where the origin is known to lie inside the media of `stack`.
+    PathSegment nextSegment(const PathRay& path, const MediumStack& stack, bool cameraRay,
+                            double within = Infinity) const;
     /// A camera path at a surface hit, shared by both integrators' Li(). An index-matched boundary is
     /// crossed (the stack toggled; Stop past MaxBoundaryCrossings). Any other surface is a vertex:
     /// past settings.maxDepth the path stops; else a lambertian surface adds its next-event estimate

@@ -68,6 +68,7 @@ public:
         // estimate as always), through media and index-matched boundaries, and collects nothing else.
         double photonShare = 0;
         bool ending = false;
+        bool fromCollision = false;  // the ray starts at a medium collision (inside the media of `stack`)
 
         auto add = [&](const Spectrum& L, bool singleCandidate) {
             if (branch == Branch::Undecided) out.surface += L;  // lights/environment seen directly
@@ -84,77 +85,113 @@ public:
 
         for (int segment = 0;; ++segment) {
             rng.startSegment(segment);
-            PathSegment ahead = nextSegment(path, stack, firstSegment);
-            const double tEnd = ahead.tEnd;
-            if (firstSegment && ahead.hasHit) out.depth = ahead.hit.t;
-
             // Medium interaction along [mediumFrom, tEnd].
             bool scattered = false, absorbed = false;
             MediumEvent scatter{};
             MediumAggregate media;
             Ray local{ray.at(mediumFrom), ray.d};
+            if (scene_.hasMedia()) media = scene_.mediaFor(stack);
+            bool emissive = false, photonSegment = false, sealed = false;
+            if (media.size()) {
+                emissive = media.isEmissive();
+                photonShare = photons_ && !ending ? photons_->share(stack) : 0.0;
+                // Inside a translucent object the photons take everything scattered (no vertex
+                // there can sample a light), and in open media where combined's automatic share
+                // gives them the segment: it is the photon map's camera segment (its march's single
+                // scattering in open media, the gather, then the transmittance as a weight) and no
+                // collision is sampled.
+                photonSegment = photonShare >= 1 && photons_->wholeSegment(stack);
+                // No equiangular sample inside a dielectric no shadow ray can leave (it returns zero
+                // there, and the collisions' next-event estimate it is weighed against is skipped).
+                sealed = scene_.sealedFromLights(stack);
+            }
+            const bool equiangular = media.size() && hasPointLights_ && !ending && !photonSegment && !sealed;
+            // From a medium collision, where nothing but the flight needs the segment's end (the
+            // equiangular sample, emission and combined's photon share estimate the whole segment,
+            // up to the surface), the flight comes first and the search ends where it stopped
+            // (EarlyFlight).
+            EarlyFlight early;
+            const bool flightFirst =
+                media.size() && fromCollision && !equiangular && !emissive && photonShare == 0 && !photonSegment;
+            if (flightFirst) {
+                rng.event(Rng::Event::Flight);
+                early = flyEarly(media, local, std::isinf(tMax) ? 1e30 : tMax - mediumFrom, beta, rng);
+            }
+            PathSegment ahead = nextSegment(path, stack, firstSegment,
+                                            early.stop == EarlyFlight::Stop::Collided ? mediumFrom + early.t : Infinity);
+            const double tEnd = ahead.tEnd;
+            if (firstSegment && ahead.hasHit) out.depth = ahead.hit.t;
+            const double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
+            // One tentative collision of the camera path's flight; false when it stopped there.
+            auto collide = [&](const MediumEvent& e, double from) {
+                Collision c = spectralTracking(e, beta, rng);
+                if (c == Collision::Null) return true;
+                if (c == Collision::Scatter) {
+                    scatter = e;
+                    scatter.t += from;
+                    scattered = true;
+                } else {
+                    absorbed = true;
+                }
+                return false;
+            };
             Support support;
-            if (scene_.hasMedia()) {
-                media = scene_.mediaFor(stack);
-                if (media.size()) {
-                    bool emissive = media.isEmissive();
-                    photonShare = photons_ && !ending ? photons_->share(stack) : 0.0;
-                    // Inside a translucent object the photons take everything scattered (no vertex
-                    // there can sample a light), and in open media where combined's automatic share
-                    // gives them the segment: it is the photon map's camera segment (its march's single
-                    // scattering in open media, the gather, then the transmittance as a weight) and no
-                    // collision is sampled.
-                    const bool photonSegment = photonShare >= 1 && photons_->wholeSegment(stack);
-                    double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
-                    if (hasPointLights_ && !ending && !photonSegment) {
-                        support = mediaSupport(media, local, length);
-                        rng.event(Rng::Event::Equiangular);
-                        addAlong(out.single, equiangularPointLight(media, local, support, stack, beta, rng));
-                    }
-                    if (emissive && !ending) {
-                        rng.event(Rng::Event::Emission);
-                        addAlong(out.emission, beta * ratioTrackedEmission(media, local, length, rng));
-                    }
-                    if (photonSegment) {
-                        // No flight is sampled: the march's offset and first light samples take the
-                        // flight's stratified dimensions (PCG32 otherwise; 1.4x the photon map's RMSE
-                        // on fog + spot, whose camera paths draw every dimension in order).
-                        rng.event(Rng::Event::Flight);
-                        PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
-                        addAlong(out.single, beta * a.single);
-                        addAlong(out.multiple, beta * a.multiple);
-                        if (firstSegment && (a.interacted || !a.multiple.isBlack())) out.alpha = 1;
-                        beta *= a.T;
-                        absorbed = beta.isBlack();
-                    } else {
-                        const Spectrum betaSegment = beta;
-                        rng.event(Rng::Event::Flight);
-                        FlightEnd end = sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
-                            Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
-                            for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
-                            double pc = (e.mp.sigma_t() * beta).average(), pn = (sigma_n * beta).average();
-                            double total = pc + pn;
-                            if (!(total > 0)) { absorbed = true; return false; }
-                            if (rng.uniform() * total < pc) {
-                                // A real collision scatters, carrying the albedo as a weight (sigma_s in
-                                // the phase kernel below) instead of ending the path with probability
-                                // sigma_a / sigma_t; Russian roulette ends low-throughput paths later.
-                                if (e.mp.sigma_s.isBlack()) { absorbed = true; return false; }
-                                beta *= total / (e.sigmaMaj * pc);
-                                scatter = e;
+            if (media.size()) {
+                if (equiangular) {
+                    support = mediaSupport(media, local, length);
+                    rng.event(Rng::Event::Equiangular);
+                    addAlong(out.single, equiangularPointLight(media, local, support, stack, beta, rng));
+                }
+                if (emissive && !ending) {
+                    rng.event(Rng::Event::Emission);
+                    addAlong(out.emission, beta * ratioTrackedEmission(media, local, length, rng));
+                }
+                if (photonSegment) {
+                    // No flight is sampled: the march's offset and first light samples take the
+                    // flight's stratified dimensions (PCG32 otherwise; 1.4x the photon map's RMSE
+                    // on fog + spot, whose camera paths draw every dimension in order).
+                    rng.event(Rng::Event::Flight);
+                    PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
+                    addAlong(out.single, beta * a.single);
+                    addAlong(out.multiple, beta * a.multiple);
+                    if (firstSegment && (a.interacted || !a.multiple.isBlack())) out.alpha = 1;
+                    beta *= a.T;
+                    absorbed = beta.isBlack();
+                } else {
+                    const Spectrum betaSegment = beta;
+                    if (flightFirst) {
+                        if (early.stop == EarlyFlight::Stop::Collided && tEnd == mediumFrom + early.t) {
+                            // Nothing met before the flight stopped: its collision stands.
+                            beta = early.beta;
+                            if (early.scattered) {
+                                scatter = early.event;
                                 scatter.t += mediumFrom;
                                 scattered = true;
-                                return false;
+                            } else {
+                                absorbed = true;
                             }
-                            beta *= sigma_n * (total / (e.sigmaMaj * pn));
-                            return true;
-                        });
-                        absorbed |= end == FlightEnd::Truncated;
-                        if (photonShare > 0) {
-                            // The photons' estimate along the whole segment, whatever the flight did:
-                            // it and the continuation from a collision (below) estimate the same light.
-                            addAlong(out.multiple, betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare);
+                        } else {
+                            // The segment ends first: the null collisions before its end, then
+                            // (where the flight stopped early and the segment goes on) the rest of
+                            // the flight from there, a free flight being memoryless.
+                            beta = early.betaBefore(length, beta);
+                            if (early.stop == EarlyFlight::Stop::Bailed && early.t < length) {
+                                const double from = mediumFrom + early.t;
+                                FlightEnd end = sampleFreeFlight(media, Ray{local.at(early.t), local.d}, length - early.t,
+                                                                 rng, [&](const MediumEvent& e) { return collide(e, from); });
+                                absorbed |= end == FlightEnd::Truncated;
+                            }
                         }
+                    } else {
+                        rng.event(Rng::Event::Flight);
+                        FlightEnd end = sampleFreeFlight(media, local, length, rng,
+                                                         [&](const MediumEvent& e) { return collide(e, mediumFrom); });
+                        absorbed |= end == FlightEnd::Truncated;
+                    }
+                    if (photonShare > 0) {
+                        // The photons' estimate along the whole segment, whatever the flight did:
+                        // it and the continuation from a collision (below) estimate the same light.
+                        addAlong(out.multiple, betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare);
                     }
                 }
             }
@@ -211,11 +248,13 @@ public:
                 prevSurface = false;
                 specular = false;
                 path.bounce({p, w}, 0.0);
+                fromCollision = true;
                 firstSegment = false;
                 lightHitIsSingle = firstVertex;
                 if (!roulette(beta, depth, rng)) break;
                 continue;
             }
+            fromCollision = false;
             if (ahead.leavesHole()) {
                 path.leaveHole(stack, ahead.leakExit);
                 continue;
@@ -278,6 +317,75 @@ private:
     };
 
     bool isPointLight(int i) const { return i >= 0 && pointLight_[i]; }
+
+    enum class Collision { Null, Scatter, Absorb };
+    /// Spectral tracking's choice at one tentative collision (the header's P_c and P_n), with beta
+    /// updated: a real collision scatters with the albedo as a weight (sigma_s in the phase kernel)
+    /// instead of ending the path with probability sigma_a / sigma_t; Russian roulette ends
+    /// low-throughput paths later.
+    static Collision spectralTracking(const MediumEvent& e, Spectrum& beta, Rng& rng) {
+        Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
+        for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
+        double pc = (e.mp.sigma_t() * beta).average(), pn = (sigma_n * beta).average();
+        double total = pc + pn;
+        if (!(total > 0)) return Collision::Absorb;
+        if (rng.uniform() * total < pc) {
+            if (e.mp.sigma_s.isBlack()) return Collision::Absorb;
+            beta *= total / (e.sigmaMaj * pc);
+            return Collision::Scatter;
+        }
+        beta *= sigma_n * (total / (e.sigmaMaj * pn));
+        return Collision::Null;
+    }
+
+    /// A flight sampled before the surfaces ahead are searched, from a medium collision (Mitsuba 3's
+    /// volpath does so in homogeneous media and shortens the ray to the sampled distance): the search
+    /// then ends at the flight's collision, in a dense medium far nearer than the next surface, which
+    /// shortens Embree's traversal. Its null collisions are logged, for the throughput at a surface
+    /// met first. It stops early (Bailed) when the log is full (a run of null collisions: a loose
+    /// majorant, or a channel the medium hardly stops); the flight goes on from there once the
+    /// segment's end is known (a free flight is memoryless).
+    struct EarlyFlight {
+        enum class Stop { None, Collided, Bailed };
+        static constexpr int MaxNulls = 16;
+        Stop stop = Stop::None;
+        double t = Infinity;     ///< where it stopped (along the local ray)
+        bool scattered = false;  ///< Collided: it scatters (else it absorbs)
+        MediumEvent event{};     ///< Collided: the collision
+        Spectrum beta;           ///< the throughput after its last event
+        int nulls = 0;
+        double nullT[MaxNulls];
+        Spectrum nullBeta[MaxNulls];
+
+        /// The throughput after the null collisions before distance t, from `start`.
+        Spectrum betaBefore(double t, const Spectrum& start) const {
+            Spectrum b = start;
+            for (int i = 0; i < nulls && nullT[i] < t; ++i) b = nullBeta[i];
+            return b;
+        }
+    };
+    static EarlyFlight flyEarly(const Medium& media, const Ray& local, double length, const Spectrum& beta, Rng& rng) {
+        EarlyFlight f;
+        f.beta = beta;
+        sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
+            Collision c = spectralTracking(e, f.beta, rng);
+            f.t = e.t;
+            if (c != Collision::Null) {
+                f.stop = EarlyFlight::Stop::Collided;
+                f.scattered = c == Collision::Scatter;
+                f.event = e;
+                return false;
+            }
+            f.nullT[f.nulls] = e.t;
+            f.nullBeta[f.nulls++] = f.beta;
+            if (f.nulls == EarlyFlight::MaxNulls) {
+                f.stop = EarlyFlight::Stop::Bailed;
+                return false;
+            }
+            return true;
+        });
+        return f;
+    }
 
     static constexpr double EmissionRouletteBelow = 0.2;
     /// The emission along the whole segment, integral of T(0, t) emission(t) dt, by ratio tracking:

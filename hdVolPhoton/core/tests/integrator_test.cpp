@@ -295,6 +295,81 @@ TEST(IntegratorDome, AConstantDomeIsSampledByThePhaseAtMediumVertices) {
     EXPECT_LT(constant.pixelVariance, 0.8 * textured.pixelVariance);
 }
 
+TEST(IntegratorFlight, ChromaticFlightsBeforeTheSearchMatchEachChannelAlone) {
+    // From a medium collision the path tracer samples its flight before it searches for surfaces
+    // (pathTracer.cpp, EarlyFlight): it logs the null collisions, for the throughput at a surface met
+    // first, and stops after 16 of them to go on once the search has found the segment's end. A
+    // strongly chromatic medium (sigma_t 12 x (0.05, 1, 0.4), albedo (0.95, 0.5, 0.8): red meets null
+    // collisions at 95% of the majorant, so red-heavy paths stop early and go on) fills a box of side
+    // 6 cut by a grey lambertian slab, lit by a sun; each channel must match the same scene with a
+    // grey medium of that channel's coefficients (no null collisions): image means over 16 seeds
+    // within 4 standard errors. Measured: without the log red is -7% (beta at the slab), without the
+    // flight going on after stopping early -25%.
+    const Spectrum scale(0.05, 1, 0.4), albedo(0.95, 0.5, 0.8);
+    auto scene = [](const Spectrum& k, const Spectrum& a) {
+        auto c = MediumCoefficients::fromAlbedo(12.0, k, a, Spectrum(0.0), makeHenyeyGreensteinPhase(0.3));
+        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-3, -3, -3), Vec3(3, 3, 3)}),
+                                   Vec3(0.9, 3.6, 7.5));
+        MeshDesc floor = test::boxMesh("floor", Vec3(-2.5, -0.4, -2.5), Vec3(2.5, -0.3, 2.5));
+        floor.material.albedo = Spectrum(0.6);
+        d.meshes.push_back(floor);
+        d.instances.push_back({0, Affine()});
+        d.lights = {makeDistantLight(normalize(Vec3(-1, -0.3, 0.2)), 0.0, Spectrum(3.0))};
+        return d;
+    };
+    RenderSettings s = smallSettings(RenderSettings::Integrator::PathTracer, 128, 0);
+    for (int ch = 0; ch < 3; ++ch) {
+        auto channelMean = [ch](const Film& f) { return aovMean(f, Film::Aov::Beauty, ch); };
+        test::MeanAndError chromatic = test::imageMean(scene(scale, albedo), s, channelMean);
+        test::MeanAndError grey = test::imageMean(scene(Spectrum(scale[ch]), Spectrum(albedo[ch])), s, channelMean);
+        std::printf("channel %d: chromatic %.5f +- %.5f, grey %.5f +- %.5f\n", ch, chromatic.mean, chromatic.stderr_,
+                    grey.mean, grey.stderr_);
+        EXPECT_NEAR(chromatic.mean, grey.mean, 4 * std::hypot(chromatic.stderr_, grey.stderr_))
+            << "channel " << ch;
+    }
+}
+
+TEST(IntegratorFlight, FlightsBeforeTheSearchThroughLooseMajorantsAddUpWithEmission) {
+    // The flight-first order where the majorants are loose (a VDB cloud, whose majorant cells bound
+    // several voxels: flights from collisions log null collisions) and a lambertian block cuts the
+    // cloud. Emission turns that order off (ratio-tracked emission needs the segment's end first),
+    // so by linearity the cloud lit by a sun and emitting (A, searched first) must equal the cloud
+    // lit by the sun alone (B, flight first) plus the cloud emitting in the dark (C, searched
+    // first): per channel within 4 standard errors of the difference (16 seeds each).
+    std::string path = testing::TempDir() + "volphoton_flight_cloud.vdb";
+    writeProceduralCloudVdb(path, 32, 2.0 / 32, 11);
+    auto scene = [&](bool sun, bool emits) {
+        GridMediumDesc gd;
+        gd.filePath = path;
+        gd.densityScale = 12.0;
+        gd.albedo = Spectrum(0.95, 0.7, 0.85);
+        gd.emission = emits ? Spectrum(0.3, 0.2, 0.1) : Spectrum(0.0);
+        MediumPtr grid = loadGridMedium(gd);
+        Bounds3 b = grid->bounds();
+        Vec3 c = (b.lo + b.hi) * 0.5;
+        SceneDesc d = furnaceScene(grid, c + Vec3(0.4, 0.8, 2.6));
+        d.camera = lookAt(c + Vec3(0.4, 0.8, 2.6), c, 0.4);
+        d.lights = sun ? std::vector<LightPtr>{makeDistantLight(normalize(Vec3(-1, -0.3, 0.2)), 0.0, Spectrum(3.0))}
+                        : std::vector<LightPtr>{};
+        MeshDesc block = test::boxMesh("block", c + Vec3(-0.5, -1.5, -0.5), c + Vec3(0.5, -0.1, 0.5));
+        block.material.albedo = Spectrum(0.6);
+        d.meshes.push_back(block);
+        d.instances.push_back({0, Affine()});
+        return d;
+    };
+    RenderSettings s = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
+    for (int ch = 0; ch < 3; ++ch) {
+        auto channelMean = [ch](const Film& f) { return aovMean(f, Film::Aov::Beauty, ch); };
+        test::MeanAndError a = test::imageMean(scene(true, true), s, channelMean);
+        test::MeanAndError b = test::imageMean(scene(true, false), s, channelMean);
+        test::MeanAndError c = test::imageMean(scene(false, true), s, channelMean);
+        std::printf("channel %d: sun + emission %.5f +- %.5f, sun %.5f +- %.5f, emission %.5f +- %.5f\n", ch, a.mean,
+                    a.stderr_, b.mean, b.stderr_, c.mean, c.stderr_);
+        EXPECT_NEAR(a.mean, b.mean + c.mean, 4 * std::sqrt(a.stderr_ * a.stderr_ + b.stderr_ * b.stderr_ + c.stderr_ * c.stderr_))
+            << "channel " << ch;
+    }
+}
+
 TEST(IntegratorEmission, EquilibriumWithDome) {
     // Emission sigma_a L_e in a dome of radiance L_e: every pixel L_e.
     const double Le = 0.7;
