@@ -15,6 +15,7 @@ bool MediumAggregate::add(const Medium* medium) {
 
 MediumProperties MediumAggregate::properties(const Vec3& p) const {
     work::lookups += lookupCost_;
+    if (count_ == 1) return media_[0]->properties(p);  // the sum below, without building it twice
     MediumProperties sum;
     for (int i = 0; i < count_; ++i) {
         MediumProperties mp = media_[i]->properties(p);
