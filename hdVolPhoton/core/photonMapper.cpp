@@ -842,12 +842,12 @@ private:
         }
         if (flux.isBlack() || !flux.isFinite()) return;
         MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
+        MediumEvent ev;  // where the photon scatters (read only when `scattered`); built once per photon
         for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < MaxBoundaryCrossings;) {
             SurfaceHit hit;
             bool hasHit = scene_.intersect(ray, path.tMin, Infinity, &hit);
             double tEnd = hasHit ? hit.t : std::min(1e30, leakDistance(stack, ray));
             bool scattered = false, absorbed = false;
-            MediumEvent ev{};
             MediumAggregate media = scene_.mediaFor(stack);
             if (media.size()) {
                 // Beams (photonBeams) of multiply scattered light: the flight in pieces of constant
