@@ -126,8 +126,9 @@ PathSegment Integrator::nextSegment(const PathRay& path, const MediumStack& stac
     if (seg.hasLight && !std::isinf(seg.tLight)) seg.tEnd = std::min(seg.tEnd, seg.tLight);
     // A limited search that meets nothing inside a closed mesh is no sign of a crossing missed
     // (leakDistance): the origin is inside, and so is everything up to `within`.
-    const bool closedAround = stack.innermost() >= 0 && scene_.meshClosed(stack.innermost());
-    seg.leakExit = seg.hasHit || (limited && closedAround) ? Infinity : leakDistance(stack, path.ray);
+    const int around = stack.innermost();
+    seg.leakExit = seg.hasHit || (limited && around >= 0 && scene_.meshClosed(around)) ? Infinity
+                                                                                     : leakDistance(stack, path.ray);
     if (seg.leakExit < seg.tEnd) seg.tEnd = seg.leakExit;
     return seg;
 }

@@ -109,8 +109,8 @@ public:
                 // scattering in open media, the gather, then the transmittance as a weight) and no
                 // collision is sampled.
                 photonSegment = photonShare >= 1 && photons_->wholeSegment(stack);
-                // No equiangular sample inside a dielectric no shadow ray can leave (it returns zero
-                // there, and the collisions' next-event estimate it is weighed against is skipped).
+                // Inside a dielectric no shadow ray can leave, neither the equiangular sample nor the
+                // collisions' next-event estimate it is weighed against is taken (both return zero).
                 sealed = scene_.sealedFromLights(stack);
             }
             const bool equiangular = media.size() && hasPointLights_ && !ending && !photonSegment && !sealed;
@@ -213,7 +213,7 @@ public:
                 // Next-event estimation (none inside a dielectric that no shadow ray can leave).
                 rng.event(Rng::Event::Light);
                 PhaseAt phase{mp, ray.d};
-                DirectSample ds = scene_.sealedFromLights(stack) ? DirectSample{} : sampleDirect(p, rng, &phase);
+                DirectSample ds = sealed ? DirectSample{} : sampleDirect(p, rng, &phase);
                 if (ds.light >= 0 && ds.ls.pdf > 0 && !ds.ls.Li.isBlack()) {
                     double cosTheta = dot(ray.d, ds.ls.wi);
                     Spectrum f = mp.scatterKernel(cosTheta);
