@@ -42,7 +42,7 @@ def test_generated_extreme_scenes(tmp_path):
     assert len(cases) >= 40
     vdb = str(tmp_path / "cloud.vdb")
     _core.write_procedural_cloud_vdb(vdb, 32, 1.0 / 32, 1)
-    results, failures = stress.run_generated([c["id"] for c in cases], vdb, passes=6, per_case_timeout=60,
+    results, failures = stress.run_generated([c["id"] for c in cases], vdb, passes=12, per_case_timeout=60,
                                              per_process=len(cases), log=print)
     failures = _split_known(failures)
     assert not failures, "stress failures:\n" + _describe(failures)

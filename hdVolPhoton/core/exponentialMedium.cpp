@@ -35,16 +35,14 @@ ExponentialMedium::ExponentialMedium(const MediumCoefficients& c, double a, doub
     if (!c.phase) throw std::invalid_argument("exponential medium: missing phase function");
     up_ = normalize(up);
     sigmaMaxChannel_ = c_.sigma_t().maxValue();
-}
-
-double ExponentialMedium::densityCapExponent() const {
+    logA_ = std::log(a_);
     // Capped so that sigma_t itself stays finite (<= 1e300): beyond that the medium is opaque anyway.
-    return std::min(MaxExponent, std::log(1e300 / std::max(1.0, sigmaMaxChannel_)));
+    cap_ = std::min(MaxExponent, std::log(1e300 / std::max(1.0, sigmaMaxChannel_)));
 }
 
 double ExponentialMedium::relativeDensity(const Vec3& p) const {
     double h = dot(p - origin_, up_);
-    return std::exp(std::min(std::log(a_) - b_ * h, densityCapExponent()));
+    return std::exp(std::min(logA_ - b_ * h, cap_));
 }
 
 MediumProperties ExponentialMedium::properties(const Vec3& p) const {
@@ -69,7 +67,7 @@ void ExponentialMedium::majorants(const Ray& ray, double tMin, double tMax, Majo
     if (sigmaMaxChannel_ == 0 || a_ == 0 || !bounds_.intersect(ray, tMin, tMax, &t0, &t1)) return;
     const double cap = densityCapExponent();
     const double decay = b_ * dot(ray.d, up_);                                // d(log density)/dt = -decay
-    const double log0 = std::log(a_) - b_ * dot(ray.at(t0) - origin_, up_);  // unclamped, at t0
+    const double log0 = logA_ - b_ * dot(ray.at(t0) - origin_, up_);  // unclamped, at t0
     auto emit = [&](double ta, double tb, bool clamped, double logStart) {
         if (clamped) segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(cap), 0.0});
         else segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(std::min(logStart, cap)), decay});

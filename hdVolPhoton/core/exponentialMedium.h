@@ -29,6 +29,7 @@ public:
     MediumProperties properties(const Vec3& p) const override;
     void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
     std::optional<Spectrum> opticalDepth(const Ray& ray, double t0, double t1) const override;
+    bool hasClosedFormDepth() const override { return true; }
     Bounds3 bounds() const override { return bounds_; }
     bool isEmissive() const override { return !c_.emission.isBlack() && a_ > 0; }
     double maxAlbedo() const override;
@@ -39,7 +40,7 @@ public:
     /// Relative density a e^{-b h} at p, with the exponent clamped so it stays finite.
     double relativeDensity(const Vec3& p) const;
     /// log of the largest relative density: beyond it the density is clamped (sigma_t <= 1e300).
-    double densityCapExponent() const;
+    double densityCapExponent() const { return cap_; }
 
 private:
     MediumCoefficients c_;
@@ -47,6 +48,7 @@ private:
     Vec3 origin_, up_;
     Bounds3 bounds_;
     double sigmaMaxChannel_;
+    double logA_, cap_;  // log a (-inf for a = 0) and the cap, computed once: lookups are hot
 };
 
 }  // namespace volphoton

@@ -82,4 +82,44 @@ FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rn
     return end;
 }
 
+/// The majorant's optical depth over (0, tMax), or a value >= stopAt once it reaches that (the walk
+/// stops there).
+inline double majorantDepth(const Medium& medium, const Ray& ray, double tMax, double stopAt) {
+    double total = 0;
+    medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
+        total += seg.opticalDepth(std::min(seg.tMax, tMax) - seg.tMin);
+        return total < stopAt;
+    });
+    return total;
+}
+
+/// A distance drawn from the free-flight routine's tentative-collision density conditioned on a
+/// collision within (0, tMax): p(t) = sigma_maj(t) e^{-tau_maj(0, t)} / P, where P = 1 -
+/// e^{-tau_maj(0, tMax)} (majorantDepth) is the probability that the first tentative collision falls
+/// there (the "forced" or conditional distance sampling of e.g. Cycles' volume direct light). t is
+/// infinite where P = 0.
+struct ConditionedFlight {
+    double t = Infinity;
+    double density = 0;  ///< p(t)
+};
+inline ConditionedFlight sampleConditionedFlight(const Medium& medium, const Ray& ray, double tMax, double P, double u) {
+    ConditionedFlight f;
+    if (!(P > 0)) return f;
+    // The optical depth of the sampled point, inverted within the majorant segment holding it.
+    double tau = -std::log1p(-u * P), left = tau;
+    medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
+        double len = std::min(seg.tMax, tMax) - seg.tMin;
+        double depth = seg.opticalDepth(len);
+        if (left >= depth) {
+            left -= depth;
+            return true;
+        }
+        double s = std::min(invertMajorantDepth(left, seg.sigmaMaj, seg.decay), len);
+        f.t = seg.tMin + s;
+        f.density = seg.sigmaMaj * std::exp(-seg.decay * s - tau) / P;
+        return false;
+    });
+    return f;
+}
+
 }  // namespace volphoton

@@ -36,6 +36,7 @@ public:
     MediumProperties properties(const Vec3& p) const override;
     void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
     std::optional<Spectrum> opticalDepth(const Ray& ray, double t0, double t1) const override;
+    bool hasClosedFormDepth() const override { return true; }
     Bounds3 bounds() const override { return bounds_; }
     bool isEmissive() const override { return !c_.emission.isBlack(); }
     double maxAlbedo() const override;

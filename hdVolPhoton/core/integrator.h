@@ -32,10 +32,10 @@
 // | rouletteDepth       | int    | 3          |              | events before Russian roulette may end a path     |
 // | seed                | uint64 | 0          |              | every random stream hashes (pixel, the pixel's    |
 // |                     |        |            |              | sample index, seed)                               |
-// | stratifiedDims      | int    | 516        |              | dimensions per camera sample taken from scrambled |
+// | stratifiedDims      | int    | 580        |              | dimensions per camera sample taken from scrambled |
 // |                     |        |            |              | Sobol' points over the passes (Rng::stratify); the|
-// |                     |        |            |              | path tracer gives each path segment the same 32   |
-// |                     |        |            |              | (Rng::startSegment): 516 covers 16 segments.      |
+// |                     |        |            |              | path tracer gives each path segment the same 36   |
+// |                     |        |            |              | (Rng::startSegment): 580 covers 16 segments.      |
 // |                     |        |            |              | 0: independent random numbers throughout          |
 // | threads             | int    | 0          |              | 0: all cores                                      |
 // | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: as many |
@@ -147,7 +147,7 @@ struct RenderSettings {
     double photonRadiusMfp = 8;
     bool photonBeams = false;
     double combinedPhotonShare = -1;  ///< -1: automatic (resolved by the Renderer from auto's pilot)
-    int stratifiedDims = 516;  // camera + 16 segments of Rng::SegmentDims
+    int stratifiedDims = 580;  // camera + 16 segments of Rng::SegmentDims
     double marchStep = 0;
     bool singleScattering = true;
     bool multipleScattering = true;

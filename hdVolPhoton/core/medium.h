@@ -106,6 +106,8 @@ public:
         (void)ray; (void)t0; (void)t1;
         return std::nullopt;
     }
+    /// opticalDepth() has a value for every ray: transmittance is exp(-tau), no tracking.
+    virtual bool hasClosedFormDepth() const { return false; }
     /// World-space box outside which the medium is empty (may be infinite).
     virtual Bounds3 bounds() const = 0;
     virtual bool isEmissive() const = 0;

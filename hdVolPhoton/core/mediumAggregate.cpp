@@ -10,6 +10,7 @@ bool MediumAggregate::add(const Medium* medium) {
     if (!medium || count_ == MaxMedia) return false;
     media_[count_++] = medium;
     lookupCost_ += medium->lookupCost();
+    closedForm_ &= medium->hasClosedFormDepth();
     return true;
 }
 

@@ -22,6 +22,8 @@ public:
     MediumProperties properties(const Vec3& p) const override;
     void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
     std::optional<Spectrum> opticalDepth(const Ray& ray, double t0, double t1) const override;
+    /// Every medium has one.
+    bool hasClosedFormDepth() const override { return count_ > 0 && closedForm_; }
     Bounds3 bounds() const override;
     bool isEmissive() const override;
     double maxAlbedo() const override;
@@ -34,6 +36,7 @@ private:
     const Medium* media_[MaxMedia] = {};
     int count_ = 0;
     double lookupCost_ = 0;
+    bool closedForm_ = true;
 };
 
 }  // namespace volphoton

@@ -160,20 +160,22 @@ public:
     /// (which would correlate two decisions of one path and bias it). Without startSegment() event()
     /// does nothing and draws take the dimensions in order (the photon map's camera paths).
     static constexpr int CameraDims = 4;    ///< pixel position pair and lens pair
-    static constexpr int SegmentDims = 32;  ///< per segment: the layout of Event
+    static constexpr int SegmentDims = 36;  ///< per segment: the layout of Event
     /// Each event's first dimension in its segment, in the order a segment uses them; its width runs
     /// to the next one's first (eventWidth).
     enum class Event : int {
-        Equiangular = 0,  ///< 2: light pick, distance
-        Emission = 2,     ///< 8: the emission estimate's first tentative collisions and roulette
-        Flight = 10,      ///< 10: the first five tentative collisions, each with its real/null choice
-        Light = 20,       ///< 8: light pick and position pair, or one pair per light (lightPair)
-        Scatter = 28,     ///< 3: direction pair, then lobe or Fresnel choice
-        Roulette = 31,    ///< 1
+        Equiangular = 0,    ///< 2: light pick, distance
+        SegmentLight = 2,   ///< 4: distance, light pick and position pair
+        Emission = 6,       ///< 8: the emission estimate's first tentative collisions and roulette
+        Flight = 14,        ///< 10: the first five tentative collisions, each with its real/null choice
+        Light = 24,         ///< 8: light pick and position pair, or one pair per light (lightPair)
+        Scatter = 32,       ///< 3: direction pair, then lobe or Fresnel choice
+        Roulette = 35,      ///< 1
     };
     static constexpr int eventWidth(Event e) {
         switch (e) {
-            case Event::Equiangular: return int(Event::Emission) - int(e);
+            case Event::Equiangular: return int(Event::SegmentLight) - int(e);
+            case Event::SegmentLight: return int(Event::Emission) - int(e);
             case Event::Emission: return int(Event::Flight) - int(e);
             case Event::Flight: return int(Event::Light) - int(e);
             case Event::Light: return int(Event::Scatter) - int(e);

@@ -32,7 +32,7 @@ class HdVolPhotonRenderParam;
 /// | volphoton:multipleScattering | bool  | true       | photonMap: photon pass on/off                |
 /// | volphoton:seed               | int   | 0          | random seed                                  |
 /// | volphoton:rouletteDepth      | int   | 3          | events before Russian roulette               |
-/// | volphoton:stratifiedDims     | int   | 516        | dimensions per camera sample from Sobol'     |
+/// | volphoton:stratifiedDims     | int   | 580        | dimensions per camera sample from Sobol'     |
 /// | volphoton:radiusAlpha        | float | 0.7        | photonMap: radius reduction per pass (0, 1]  |
 /// | volphoton:photonRadiusMfp    | float | 8          | photonMap: kernel cap in mean free paths     |
 /// | volphoton:photonBeams        | bool  | false      | photonMap: beams where media are thin        |

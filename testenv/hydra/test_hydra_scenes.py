@@ -185,7 +185,7 @@ def test_numeric_render_settings_reach_the_core(tmp_path, hydra_env):
     and an out-of-range radiusAlpha) reach the core through the render-settings Bprim: the same
     seed renders bit-identically with the default value spelled out, differently with another value,
     and an out-of-range value is clamped with a warning naming the setting."""
-    variants = {"default": "", "same": "int volphoton:stratifiedDims = 516", "asdouble": "double volphoton:stratifiedDims = 516",
+    variants = {"default": "", "same": "int volphoton:stratifiedDims = 580", "asdouble": "double volphoton:stratifiedDims = 580",
                 "independent": "int volphoton:stratifiedDims = 0",
                 "badalpha": 'float volphoton:radiusAlpha = 7\n        token volphoton:integrator = "photonMap"'}
     images, logs = _render_furnace_variants(tmp_path, hydra_env, variants)

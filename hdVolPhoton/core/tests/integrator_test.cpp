@@ -433,8 +433,9 @@ TEST(IntegratorEmission, RatioTrackedEmissionThroughAGridMatchesQuadrature) {
 }
 
 namespace {
-/// Mean over seeds of a single-pixel AOV for a camera looking along -Z with a tiny field of view.
-test::MeanAndError singleRay(const SceneDesc& desc, RenderSettings::Integrator integrator, Film::Aov aov, int spp) {
+/// Mean over seeds of a single-pixel AOV (its channel) for a camera looking along -Z with a tiny field of view.
+test::MeanAndError singleRay(const SceneDesc& desc, RenderSettings::Integrator integrator, Film::Aov aov, int spp,
+                             int channel = 0) {
     auto scene = std::make_shared<Scene>(desc);
     std::vector<double> xs;
     for (int seed = 0; seed < Seeds; ++seed) {
@@ -443,7 +444,7 @@ test::MeanAndError singleRay(const SceneDesc& desc, RenderSettings::Integrator i
         s.multipleScattering = false;  // only the single-scattering pass is compared
         Renderer r(scene, s);
         r.render();
-        xs.push_back(r.film().resolveRgb(aov)[0]);
+        xs.push_back(r.film().resolveRgb(aov)[channel]);
     }
     return meanAndError(xs);
 }
@@ -470,6 +471,52 @@ TEST(IntegratorSingleScattering, AirlightClosedForm) {
         EXPECT_NEAR(me.mean, expected, 4 * me.stderr_) << (integrator == RenderSettings::Integrator::PathTracer ? "path tracer" : "photon map");
         EXPECT_LT(me.stderr_, 0.05 * expected);
     }
+}
+
+TEST(IntegratorSingleScattering, SunlitSlabsOfEveryDepthMatchQuadrature) {
+    // A sun behind a slab of depth 1 (z in [-2, -1], 2000 wide) seen head-on by one camera ray, the
+    // light 50 degrees off the ray: single scattering is sigma_s(y) / 4pi E e^{-tau_cam(y)}
+    // e^{-tau_sun(y) / cos 50} integrated over the depth y (quadrature here, 20000 midpoints). Thin
+    // segments take their sun from the segment-light strategy (pathTracer.cpp) and the collisions'
+    // next-event estimate shares it by MIS; it is always taken below a majorant depth of 3, on a
+    // falling share up to 9 and not past it, so the slabs' depths 0.05, 1.5 and 6 (x the chromatic
+    // scale 1, 0.5, 0.2) cover all three, in a homogeneous and in an exponential medium (density
+    // e^{-1.5 y}: decaying majorants). Each channel within 4 standard errors of 16 seeds.
+    // Measured: the collisions' estimate at full weight is +95% (depth 0.05), +56% (1.5) and +8%
+    // (homogeneous, depth 6: the strategy taken with probability e^-3); every case fails.
+    const double cosSun = std::cos(50 * Pi / 180), E = 3.0, albedo = 0.8, b = 1.5;
+    const Spectrum scale(1.0, 0.5, 0.2);
+    const Bounds3 slab{Vec3(-1000, -1000, -2), Vec3(1000, 1000, -1)};
+    for (bool exponential : {false, true})
+        for (double depth : {0.05, 1.5, 6.0}) {
+            SceneDesc d;
+            auto c = MediumCoefficients::fromAlbedo(depth, scale, Spectrum(albedo), Spectrum(0.0), makeIsotropicPhase());
+            // Exponential: density e^{-b y} at depth y below the near face (z = -1).
+            if (exponential) d.media.push_back(std::make_shared<ExponentialMedium>(c, 1.0, b, Vec3(0, 0, -1), Vec3(0, 0, -1), slab));
+            else d.media.push_back(std::make_shared<HomogeneousMedium>(c, slab));
+            d.unboundedMedia.push_back(0);
+            // The light travels towards the camera's side (+z), 50 degrees off the axis.
+            d.lights.push_back(makeDistantLight(Vec3(std::sin(50 * Pi / 180), 0, cosSun), 0.0, Spectrum(E)));
+            d.camera.tanHalfFovX = 1e-7;
+            for (int ch = 0; ch < 3; ++ch) {
+                auto me = singleRay(d, RenderSettings::Integrator::PathTracer, Film::Single, 1024, ch);
+                double sigma = depth * scale[ch];  // sigma_t at the near face
+                // Optical depth from the near face to y, and from y to the far face.
+                auto tau = [&](double y0, double y1) {
+                    return exponential ? sigma * (std::exp(-b * y0) - std::exp(-b * y1)) / b : sigma * (y1 - y0);
+                };
+                const int n = 20000;
+                double expected = 0;
+                for (int i = 0; i < n; ++i) {
+                    double y = (i + 0.5) / n, density = exponential ? std::exp(-b * y) : 1.0;
+                    expected += albedo * sigma * density * Inv4Pi * E * std::exp(-tau(0, y) - tau(y, 1) / cosSun) / n;
+                }
+                std::printf("%s depth %.2f channel %d: %.8f +- %.8f, quadrature %.8f (z %.2f)\n", exponential ? "exponential" : "homogeneous",
+                            depth, ch, me.mean, me.stderr_, expected, (me.mean - expected) / me.stderr_);
+                EXPECT_NEAR(me.mean, expected, 4 * me.stderr_)
+                    << (exponential ? "exponential" : "homogeneous") << " depth " << depth << " channel " << ch;
+            }
+        }
 }
 
 TEST(IntegratorSingleScattering, APixelImagingAPointLightMatchesQuadrature) {
@@ -1590,8 +1637,9 @@ TEST(IntegratorCancel, CancelStopsTilesAndPhotonBatches) {
 TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
     // domeVisibleToCamera = false (Hydra's domeLightCameraVisibility): camera rays that escape see
     // black; everything the dome lights is unchanged. With the same seed the two renders take the same
-    // random decisions, so no pixel gets brighter, pixels no sample of which met the medium are 0,
-    // and the lit cube is still there.
+    // random decisions, so no pixel gets brighter, pixels no sample of which collided in the medium
+    // (alpha 0) lose exactly the dome seen directly (1; what they scattered towards the camera from
+    // the segment-light strategy stays), and the lit cube is still there.
     for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
         auto scene = domeLitCubeScene();
         RenderSettings s = smallSettings(integrator, 4, 7);
@@ -1609,8 +1657,7 @@ TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
             for (int ch = 0; ch < 3; ++ch) EXPECT_LE(h[3 * p + ch], v[3 * p + ch] + 1e-9) << "pixel " << p;
             if (alpha[p] == 0) {
                 ++background;
-                EXPECT_NEAR(v[3 * p], 1.0, 1e-9) << "pixel " << p;  // the dome seen directly
-                EXPECT_EQ(h[3 * p], 0.0) << "pixel " << p;
+                EXPECT_NEAR(v[3 * p] - h[3 * p], 1.0, 1e-6) << "pixel " << p;  // the dome seen directly
             } else {
                 lit += h[3 * p];
             }

@@ -100,7 +100,7 @@ std::vector<SettingInfo> makeTable() {
                             "Henyey-Greenstein g = 0.6)",
                             &RS::photonBeams));
     t.push_back(intSetting("stratifiedDims", 0, 4096, "", "volphoton:stratifiedDims", "Stratified dimensions (0: independent)",
-                           "", "dimensions per camera sample taken from scrambled Sobol' points; the path tracer gives each path segment the same 32 (516: 16 segments; 0: independent)",
+                           "", "dimensions per camera sample taken from scrambled Sobol' points; the path tracer gives each path segment the same 36 (580: 16 segments; 0: independent)",
                            &RS::stratifiedDims));
     t.push_back(doubleSetting("marchStep", 0, Big, "", "March step (0: auto)", "scene units",
                               "photonMap: single-scattering step (0: 1/256 of the media's diameter)", &RS::marchStep));
