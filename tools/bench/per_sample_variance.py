@@ -5,6 +5,7 @@ per pass. The scene's own RenderSettings are used except integrator (path tracer
 and time limit (off), spp, seed and --dims (stratifiedDims).
 
     python tools/bench/per_sample_variance.py homogeneous_cube,surfaces_only --spp 64 --seeds 16
+    python tools/bench/per_sample_variance.py atmosphere_sunset --spp 16 --seeds 8 --aovs   # and per AOV
 
 Compare two builds side by side by running it once with each on PYTHONPATH (a copy of another
 build's installed `volphoton` package first on PYTHONPATH)."""
@@ -21,11 +22,14 @@ from bench_load import load_bench_scene  # noqa: E402
 from volphoton import _core  # noqa: E402
 
 
+AOVS = ("single", "multiple", "surface", "emission")
+
+
 def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
-    """(per-sample variance, image mean, seconds per pass) of scene `name`."""
+    """(per-sample variance, image mean, seconds per pass, {aov: per-sample variance}) of scene `name`."""
     rs, tr = load_bench_scene(name, width, height)
     scene = _core.Scene(tr.desc)
-    images = []
+    images, aovs = [], {a: [] for a in AOVS}
     t0 = time.perf_counter()
     for seed in range(seeds):
         s = rs.settings
@@ -37,9 +41,12 @@ def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
         r = _core.Renderer(scene, s)
         r.render()
         images.append(np.asarray(r.film.beauty, np.float64))
+        for a in AOVS:
+            aovs[a].append(np.asarray(getattr(r.film, a), np.float64))
     seconds = (time.perf_counter() - t0) / (seeds * spp)
     images = np.array(images)
-    return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds
+    per_aov = {a: np.array(v).var(axis=0, ddof=1).mean() * spp for a, v in aovs.items()}
+    return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds, per_aov
 
 
 def main():
@@ -48,11 +55,15 @@ def main():
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--seeds", type=int, default=16)
     ap.add_argument("--dims", type=int, default=None, help="stratifiedDims (default: the build's default)")
+    ap.add_argument("--aovs", action="store_true", help="also the per-sample variance of each AOV")
     a = ap.parse_args()
-    print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) |\n|---|---|---|---|")
+    extra = "".join(" %s |" % k for k in AOVS) if a.aovs else ""
+    print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) |%s\n|---|---|---|---|%s"
+          % (extra, "---|" * len(AOVS) if a.aovs else ""))
     for name in a.scenes.split(","):
-        v, m, sec = per_sample_variance(name, a.spp, a.seeds, a.dims)
-        print("| %s | %.5f | %.5f | %.2f |" % (name, v, m, sec * 1e3), flush=True)
+        v, m, sec, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims)
+        cells = "".join(" %.5f |" % per_aov[k] for k in AOVS) if a.aovs else ""
+        print("| %s | %.5f | %.5f | %.2f |%s" % (name, v, m, sec * 1e3, cells), flush=True)
 
 
 if __name__ == "__main__":

@@ -1638,8 +1638,9 @@ TEST(IntegratorDome, HiddenFromCameraStillLightsTheScene) {
     // domeVisibleToCamera = false (Hydra's domeLightCameraVisibility): camera rays that escape see
     // black; everything the dome lights is unchanged. With the same seed the two renders take the same
     // random decisions, so no pixel gets brighter, pixels no sample of which collided in the medium
-    // (alpha 0) lose exactly the dome seen directly (1; what they scattered towards the camera from
-    // the segment-light strategy stays), and the lit cube is still there.
+    // (alpha 0) lose exactly the dome seen directly (1; light scattered towards the camera without a
+    // collision, as pathTracer.cpp's segment-light strategy adds in scenes with a sun, would stay),
+    // and the lit cube is still there.
     for (auto integrator : {RenderSettings::Integrator::PathTracer, RenderSettings::Integrator::PhotonMap}) {
         auto scene = domeLitCubeScene();
         RenderSettings s = smallSettings(integrator, 4, 7);
