@@ -26,10 +26,12 @@ AOVS = ("single", "multiple", "surface", "emission")
 
 
 def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
-    """(per-sample variance, image mean, seconds per pass, {aov: per-sample variance}) of scene `name`."""
+    """(per-sample variance, image mean, seconds per pass, CPU seconds per pass (every thread's, renders
+    only: steadier than wall time on a shared machine), {aov: per-sample variance}) of scene `name`."""
     rs, tr = load_bench_scene(name, width, height)
     scene = _core.Scene(tr.desc)
     images, aovs = [], {a: [] for a in AOVS}
+    cpu = 0.0
     t0 = time.perf_counter()
     for seed in range(seeds):
         s = rs.settings
@@ -39,14 +41,16 @@ def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
         if dims is not None:
             s.stratified_dims = dims
         r = _core.Renderer(scene, s)
+        c0 = time.process_time()
         r.render()
+        cpu += time.process_time() - c0
         images.append(np.asarray(r.film.beauty, np.float64))
         for a in AOVS:
             aovs[a].append(np.asarray(getattr(r.film, a), np.float64))
     seconds = (time.perf_counter() - t0) / (seeds * spp)
     images = np.array(images)
     per_aov = {a: np.array(v).var(axis=0, ddof=1).mean() * spp for a, v in aovs.items()}
-    return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds, per_aov
+    return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds, cpu / (seeds * spp), per_aov
 
 
 def main():
@@ -58,12 +62,12 @@ def main():
     ap.add_argument("--aovs", action="store_true", help="also the per-sample variance of each AOV")
     a = ap.parse_args()
     extra = "".join(" %s |" % k for k in AOVS) if a.aovs else ""
-    print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) |%s\n|---|---|---|---|%s"
+    print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) | CPU ms per pass |%s\n|---|---|---|---|---|%s"
           % (extra, "---|" * len(AOVS) if a.aovs else ""))
     for name in a.scenes.split(","):
-        v, m, sec, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims)
+        v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims)
         cells = "".join(" %.5f |" % per_aov[k] for k in AOVS) if a.aovs else ""
-        print("| %s | %.5f | %.5f | %.2f |%s" % (name, v, m, sec * 1e3, cells), flush=True)
+        print("| %s | %.5f | %.5f | %.2f | %.2f |%s" % (name, v, m, sec * 1e3, cpu * 1e3, cells), flush=True)
 
 
 if __name__ == "__main__":
