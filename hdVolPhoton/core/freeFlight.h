@@ -1,6 +1,8 @@
 // The one free-flight routine. Every estimator (camera paths, shadow rays, photons, transmittance)
 // samples distances through sampleFreeFlight(); none walks majorants on its own (pbrt-v4's SampleT_maj
-// shape, with a scalar majorant).
+// shape, with a scalar majorant). Below it, the same density conditioned on a collision within the
+// segment (sampleConditionedFlight, by the same inversion, for the path tracer's segment-light
+// strategy) and the majorant's optical depth it needs (majorantDepth).
 //
 // Within a majorant segment the majorant is sigma(t) = sigma0 e^{-k (t - t0)}, whose optical depth
 // from t0 is tau(s) = sigma0 s (1 - e^{-k s})/(k s). Tentative collisions are drawn by inverting it:
