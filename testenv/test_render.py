@@ -238,9 +238,13 @@ def test_white_furnace_through_the_whole_pipeline(tmp_path):
     """furnace.usda: an albedo-1 medium in a dome of radiance 1 renders 1 everywhere.
 
     Three seeds.  sigma = the per-pixel noise, pooled over the medium's pixels from the spread of
-    each pixel around its mean over the seeds.  Every pixel must be within k = 5.5 sigma of 1 (about
-    3000 values: a Gaussian exceeds 5.5 sigma with probability 4e-8 each), and the mean over all of
-    them within 4 sigma / sqrt(n) of 1."""
+    each pixel around its mean over the seeds.  Every pixel's mean over the seeds must be within k =
+    5.5 sigma / sqrt(3) of 1, and the mean over all of them within 4 sigma / sqrt(n) of 1.  Per-seed
+    pixels are not Gaussian at 16 samples: a path grazing the sphere's surface collects a next-event
+    estimate at many vertices, so one sample can be ~9.  Over 8 seed triples (seeds 1-12 at 856aa00
+    and at fb4f565) the worst per-seed pixel reached 4.4-6.3 sigma (the check on them, k = 5.5, failed
+    one triple in four), the worst 3-seed mean 3.1-4.7 sigma / sqrt(3): the check on means is both
+    robust to single spikes and tighter in radiance (0.28 against 0.48)."""
     shutil.copy(os.path.join(TESTENV, "furnace.usda"), tmp_path / "furnace.usda")
     images = []
     for seed in (1, 2, 3):
@@ -265,10 +269,11 @@ def test_white_furnace_through_the_whole_pipeline(tmp_path):
     dev = vals - vals.mean(axis=0, keepdims=True)
     sigma = math.sqrt((dev ** 2).sum() / (dev.size * (len(images) - 1) / len(images)))
     k = 5.5
-    print("white furnace: sigma = %.4f per pixel, k = %.1f, worst |pixel - 1| = %.4f, mean = %.5f"
-          % (sigma, k, np.abs(vals - 1).max(), vals.mean()))
+    worst = np.abs(vals.mean(axis=0) - 1).max()
+    print("white furnace: sigma = %.4f per pixel, k = %.1f, worst |3-seed pixel mean - 1| = %.4f (%.2f sigma / sqrt 3), "
+          "mean = %.5f" % (sigma, k, worst, worst / (sigma / math.sqrt(len(images))), vals.mean()))
     assert 0 < sigma < 0.25
-    assert np.abs(vals - 1).max() <= k * sigma
+    assert worst <= k * sigma / math.sqrt(len(images))
     assert abs(vals.mean() - 1) <= 4 * sigma / math.sqrt(vals.size)
 
 
