@@ -1,5 +1,6 @@
-"""Stress suite, short form (about 40 s): the generated extreme scenes and the malformed inputs of
-tools/stress.py on a fixed subset.  The long form (200+ scenes, ~300 malformed inputs, memory) is
+"""Stress suite, short form (about 40 s): the generated extreme scenes (12 passes each: the furnace
+checks' standard errors come from them, and 6 left heavy-tailed cases a 5-degree-of-freedom t-test)
+and the malformed inputs of tools/stress.py on a fixed subset.  The long form (200+ scenes, ~300 malformed inputs, memory) is
 
     python tools/stress.py --long
 

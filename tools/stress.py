@@ -19,7 +19,8 @@
        through the diagnostic sink; the film stays clean, so this catches NaNs the film hides);
      * furnace bound: in scenes lit only by a dome (or an enclosing emitter) of radiance L with non-emissive media and
        surfaces of albedo <= 1, no pixel mean exceeds L beyond its noise (6 standard errors from the
-       per-pass means, + 2% for estimator bias), nor does the image mean (4 standard errors + 1%, and
+       per-pass means, passes independent: stratifiedDims 0; + 2% for estimator bias), nor does the
+       image mean (4 standard errors + 1%, and
        never more than 1.25 L whatever the noise: spikes must not hide an energy gain);
      * no crash (each batch runs in a worker process; a signal names the case), no hang (timeout).
 2. Malformed inputs: deterministic text mutations (seeded) of the example .usda files (deleted,
