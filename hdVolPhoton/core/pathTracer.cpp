@@ -138,7 +138,7 @@ public:
             flightFirst &= !segmentLight;
             if (flightFirst) {
                 rng.event(Rng::Event::Flight);
-                flyEarly(media, local, std::isinf(tMax) ? 1e30 : tMax - mediumFrom, beta, rng, &early, &scatter);
+                flyEarly(media, local, rayLength, beta, rng, &early, &scatter);
             }
             const bool collidedEarly = flightFirst && early.stop == EarlyFlight::Stop::Collided;
             PathSegment ahead = nextSegment(path, stack, firstSegment, collidedEarly ? mediumFrom + early.t : Infinity);
