@@ -30,6 +30,8 @@
 // |                     |        |            |              | (dense bright media, e.g. clouds, milk, marble,   |
 // |                     |        |            |              | render too dark)                                  |
 // | rouletteDepth       | int    | 3          |              | events before Russian roulette may end a path     |
+// |                     |        |            |              | (one whose throughput fell below 0.1:             |
+// |                     |        |            |              | RouletteWeight, integratorBase.h)                 |
 // | seed                | uint64 | 0          |              | every random stream hashes (pixel, the pixel's    |
 // |                     |        |            |              | sample index, seed)                               |
 // | stratifiedDims      | int    | 580        |              | dimensions per camera sample taken from scrambled |

@@ -25,7 +25,7 @@ from volphoton import _core  # noqa: E402
 AOVS = ("single", "multiple", "surface", "emission")
 
 
-def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
+def per_sample_variance(name, spp, seeds, dims, width=80, height=60, overrides=()):
     """(per-sample variance, image mean, seconds per pass, CPU seconds per pass (every thread's, renders
     only: steadier than wall time on a shared machine), {aov: per-sample variance}) of scene `name`."""
     rs, tr = load_bench_scene(name, width, height)
@@ -40,6 +40,8 @@ def per_sample_variance(name, spp, seeds, dims, width=80, height=60):
         s.integrator = _core.RenderSettings.Integrator.PathTracer
         if dims is not None:
             s.stratified_dims = dims
+        for key, value in overrides:
+            setattr(s, key, type(getattr(s, key))(value))
         r = _core.Renderer(scene, s)
         c0 = time.process_time()
         r.render()
@@ -59,13 +61,16 @@ def main():
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--seeds", type=int, default=16)
     ap.add_argument("--dims", type=int, default=None, help="stratifiedDims (default: the build's default)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a RenderSettings field (snake_case, e.g. roulette_depth=1000); repeatable")
     ap.add_argument("--aovs", action="store_true", help="also the per-sample variance of each AOV")
     a = ap.parse_args()
     extra = "".join(" %s |" % k for k in AOVS) if a.aovs else ""
     print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) | CPU ms per pass |%s\n|---|---|---|---|---|%s"
           % (extra, "---|" * len(AOVS) if a.aovs else ""))
     for name in a.scenes.split(","):
-        v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims)
+        overrides = [kv.split("=", 1) for kv in a.set]
+        v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims, overrides=overrides)
         cells = "".join(" %.5f |" % per_aov[k] for k in AOVS) if a.aovs else ""
         print("| %s | %.5f | %.5f | %.2f | %.2f |%s" % (name, v, m, sec * 1e3, cpu * 1e3, cells), flush=True)
 

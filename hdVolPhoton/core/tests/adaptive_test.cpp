@@ -81,10 +81,11 @@ TEST(FilmError, RelativeErrorIsTheStandardErrorOfTheMeanOverTheMean) {
 TEST(Adaptive, StopsAtTheNoiseTargetAndItsEstimateMatchesTheTrueError) {
     // Every pixel's estimate ends at or below the target, the pixels get different sample counts,
     // and the estimate is honest: the RMS of the true relative error against a reference (16 seeds x
-    // 1024 passes: its own relative error is ~1/16 of the target's) is within a factor 2 of the RMS
-    // of the estimates.
+    // 1024 passes: its own relative error is ~1/10 of the target's) is within a factor 2 of the RMS
+    // of the estimates. (Target 0.03: at 0.05 the noisiest pixel needs only ~36 passes since roulette
+    // spares paths above its weight window, RouletteWeight.)
     auto scene = cubeScene();
-    const double target = 0.05;
+    const double target = 0.03;
     RenderSettings s = adaptiveSettings(Kind::PathTracer, target, 3);
     Renderer r(scene, s);
     r.render();
@@ -99,7 +100,7 @@ TEST(Adaptive, StopsAtTheNoiseTargetAndItsEstimateMatchesTheTrueError) {
             hi = std::max(hi, r.film().samples(x, y));
         }
     EXPECT_EQ(lo, 8u) << "dome pixels have no variance: they stop after samplesPerPixel";
-    EXPECT_GT(hi, 64u);
+    EXPECT_GT(hi, 64u) << "the noisiest pixel";
     Film reference(s.width, s.height);
     for (int seed = 100; seed < 100 + Seeds; ++seed) {
         RenderSettings rs = smallSettings(Kind::PathTracer, 1024, seed);

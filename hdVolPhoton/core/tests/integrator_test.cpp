@@ -391,6 +391,44 @@ TEST(IntegratorEmission, EquilibriumWithDome) {
     }
 }
 
+TEST(IntegratorRoulette, OnlyPathsBelowTheWeightWindowMeetIt) {
+    // The survival rule: 1 down to RouletteWeight, then the throughput over it; capped when deep.
+    EXPECT_EQ(rouletteSurvival(1.0, 3), 1.0);
+    EXPECT_EQ(rouletteSurvival(RouletteWeight, 3), 1.0);
+    EXPECT_DOUBLE_EQ(rouletteSurvival(0.25 * RouletteWeight, 3), 0.25);
+    EXPECT_EQ(rouletteSurvival(1.0, DeepRouletteDepth), DeepRouletteSurvival);
+    // A cube of albedo `albedo` under a dome, isotropic (phase sampling is exact: a collision multiplies
+    // the throughput by the albedo), paths capped at 20 events: roulette from the first event against
+    // none at all. At albedo 0.9 no path falls below the window (0.9^20 = 0.12 > 0.1): the images are
+    // bit-identical (a survival of 1 draws no number). At 0.5 it acts from the fourth event: the
+    // images differ, and their means agree within 4 standard errors of their difference over 16 seeds.
+    for (double albedo : {0.9, 0.5}) {
+        auto make = [&]() {
+            auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(albedo), Spectrum(0.0), makeIsotropicPhase());
+            return furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}), Vec3(0.2, 0.1, 3));
+        };
+        RenderSettings s = smallSettings(RenderSettings::Integrator::PathTracer, 8, 0);
+        s.maxDepth = 20;
+        s.rouletteDepth = 0;
+        auto withRoulette = renderSeeds(make, s);
+        s.rouletteDepth = 1000;
+        auto without = renderSeeds(make, s);
+        if (albedo > 0.8) {
+            EXPECT_TRUE(withRoulette == without) << "a path above the weight window met roulette";
+            continue;
+        }
+        EXPECT_FALSE(withRoulette == without) << "roulette never acted at albedo 0.5";
+        std::vector<double> diff;
+        for (size_t k = 0; k < withRoulette.size(); ++k) {
+            double d = 0;
+            for (size_t i = 0; i < withRoulette[k].size(); ++i) d += withRoulette[k][i] - without[k][i];
+            diff.push_back(d / withRoulette[k].size());
+        }
+        auto me = meanAndError(diff);
+        EXPECT_LT(std::abs(me.mean), 4 * me.stderr_ + 1e-9) << "roulette changed the image mean";
+    }
+}
+
 TEST(IntegratorEmission, RatioTrackedEmissionThroughAGridMatchesQuadrature) {
     // A purely absorbing, emissive VDB cloud (albedo 0, no lights), one camera ray through it: the
     // pixel is the integral of T(0, t) emission(t) dt, here by a 40000-step midpoint quadrature of
