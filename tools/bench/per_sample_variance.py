@@ -1,11 +1,12 @@
-"""Per-sample variance of our path tracer on benchmark scenes: for each pixel, the variance across
-seeds of its mean over `spp` samples, times spp, averaged over the pixels (so independent samples
-give the same figure at any spp, and stratified samples a lower one). Also the mean and the time
-per pass. The scene's own RenderSettings are used except integrator (path tracer), adaptive sampling
-and time limit (off), spp, seed and --dims (stratifiedDims).
+"""Per-sample variance of our path tracer (or --integrator) on benchmark scenes: for each pixel, the
+variance across seeds of its mean over `spp` samples, times spp, averaged over the pixels (so
+independent samples give the same figure at any spp, and stratified samples a lower one). Also the
+mean and the time per pass. The scene's own RenderSettings are used except integrator, adaptive
+sampling and time limit (off), spp, seed, --dims (stratifiedDims) and --set overrides.
 
     python tools/bench/per_sample_variance.py homogeneous_cube,surfaces_only --spp 64 --seeds 16
     python tools/bench/per_sample_variance.py atmosphere_sunset --spp 16 --seeds 8 --aovs   # and per AOV
+    python tools/bench/per_sample_variance.py subsurface_bunny --integrator Combined --set photons_per_pass=16000
 
 Compare two builds side by side by running it once with each on PYTHONPATH (a copy of another
 build's installed `volphoton` package first on PYTHONPATH)."""
@@ -25,7 +26,7 @@ from volphoton import _core  # noqa: E402
 AOVS = ("single", "multiple", "surface", "emission")
 
 
-def per_sample_variance(name, spp, seeds, dims, width=80, height=60, overrides=()):
+def per_sample_variance(name, spp, seeds, dims, width=80, height=60, overrides=(), integrator="PathTracer"):
     """(per-sample variance, image mean, seconds per pass, CPU seconds per pass (every thread's, renders
     only: steadier than wall time on a shared machine), {aov: per-sample variance}) of scene `name`."""
     rs, tr = load_bench_scene(name, width, height)
@@ -37,7 +38,7 @@ def per_sample_variance(name, spp, seeds, dims, width=80, height=60, overrides=(
         s = rs.settings
         s.width, s.height, s.samples_per_pixel, s.seed = width, height, spp, seed
         s.noise_target, s.time_limit = 0, 0
-        s.integrator = _core.RenderSettings.Integrator.PathTracer
+        s.integrator = getattr(_core.RenderSettings.Integrator, integrator)
         if dims is not None:
             s.stratified_dims = dims
         for key, value in overrides:
@@ -63,6 +64,7 @@ def main():
     ap.add_argument("--dims", type=int, default=None, help="stratifiedDims (default: the build's default)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a RenderSettings field (snake_case, e.g. roulette_depth=1000); repeatable")
+    ap.add_argument("--integrator", default="PathTracer", choices=["PathTracer", "PhotonMap", "Combined", "Auto"])
     ap.add_argument("--aovs", action="store_true", help="also the per-sample variance of each AOV")
     a = ap.parse_args()
     extra = "".join(" %s |" % k for k in AOVS) if a.aovs else ""
@@ -70,7 +72,8 @@ def main():
           % (extra, "---|" * len(AOVS) if a.aovs else ""))
     for name in a.scenes.split(","):
         overrides = [kv.split("=", 1) for kv in a.set]
-        v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims, overrides=overrides)
+        v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims, overrides=overrides,
+                                                      integrator=a.integrator)
         cells = "".join(" %.5f |" % per_aov[k] for k in AOVS) if a.aovs else ""
         print("| %s | %.5f | %.5f | %.2f | %.2f |%s" % (name, v, m, sec * 1e3, cpu * 1e3, cells), flush=True)
 
