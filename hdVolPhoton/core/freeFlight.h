@@ -64,7 +64,10 @@ FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rn
         double t = seg.tMin;
         double sigma = seg.sigmaMaj;
         while (true) {
-            double tau = -std::log1p(-rng.uniform());  // Exp(1); uniform() < 1 keeps it finite
+            // Exp(1). uniform() < 1 keeps it finite, and 1 - u is exact (u is a multiple of 2^-53,
+            // Rng::uniform): log(1 - u) is log1p(-u) to rounding, at half its cost (9.5% of a dense
+            // cloud's render time went to log1p here).
+            double tau = -std::log(1.0 - rng.uniform());
             double dt = invertMajorantDepth(tau, sigma, seg.decay);
             if (!(dt < seg.tMax - t)) return true;  // passed the segment: on to the next one
             if (++events > MaxTentativeCollisions) {

@@ -100,19 +100,20 @@ void MajorantGrid::walk(const Vec3& o, const Vec3& d, double tMin, double tMax, 
     // Amanatides-Woo set-up. The crossing parameters are recomputed from o at each step rather than
     // accumulated, so no drift builds up over long walks.
     int cell[3], step[3], stop[3];
-    double next[3];
+    double next[3], invD[3];  // invD: a multiplication per step instead of a division
     const Vec3 p = o + d * t0;
     for (int a = 0; a < 3; ++a) {
         double f = std::floor((p[a] - box_.lo[a]) * invCellSize_[a]);
         cell[a] = static_cast<int>(std::clamp(f, 0.0, static_cast<double>(res_[a] - 1)));
+        invD[a] = d[a] != 0 ? 1.0 / d[a] : 0.0;
         if (d[a] > 0) {
             step[a] = 1;
             stop[a] = res_[a];
-            next[a] = (box_.lo[a] + (cell[a] + 1) * cellSize_[a] - o[a]) / d[a];
+            next[a] = (box_.lo[a] + (cell[a] + 1) * cellSize_[a] - o[a]) * invD[a];
         } else if (d[a] < 0) {
             step[a] = -1;
             stop[a] = -1;
-            next[a] = (box_.lo[a] + cell[a] * cellSize_[a] - o[a]) / d[a];
+            next[a] = (box_.lo[a] + cell[a] * cellSize_[a] - o[a]) * invD[a];
         } else {
             step[a] = 0;
             stop[a] = -2;
@@ -139,7 +140,7 @@ void MajorantGrid::walk(const Vec3& o, const Vec3& d, double tMin, double tMax, 
             t = t1;  // left the box: in exact arithmetic exactly at t1, so cover any rounding sliver
             break;
         }
-        next[axis] = (box_.lo[axis] + (cell[axis] + (step[axis] > 0 ? 1 : 0)) * cellSize_[axis] - o[axis]) / d[axis];
+        next[axis] = (box_.lo[axis] + (cell[axis] + (step[axis] > 0 ? 1 : 0)) * cellSize_[axis] - o[axis]) * invD[axis];
     }
     if (runValue > 0 && t > runStart) cb(runStart, t, runValue);
 }
