@@ -53,13 +53,28 @@ enum class FlightEnd {
 constexpr int64_t MaxTentativeCollisions = int64_t(1) << 20;
 void warnTruncatedFlight();
 
+/// What a flight looks up at each tentative collision: the full coefficients, or (Extinction) sigma_t
+/// alone, which the event's mp then carries as sigma_a (no lobes, no emission): for estimators that
+/// use nothing else (ratio tracking: 31% of a dense cloud's render time; Extinction there made the
+/// dense cloud's CPU time per pass 0.95x, the VDB cloud's and the emissive smoke's unchanged).
+enum class FlightLookup { Properties, Extinction };
+
 /// Draws tentative collisions along ray over (0, tMax) through `medium`'s majorants, calling
 /// callback(const MediumEvent&) -> bool at each, in increasing t. The callback returns false to stop
 /// (a real scattering or absorption).
-template <typename Callback>
+template <FlightLookup Lookup = FlightLookup::Properties, typename Callback>
 FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback) {
     FlightEnd end = FlightEnd::Escaped;
     int64_t events = 0;
+    auto lookup = [&medium](const Vec3& p) {
+        if constexpr (Lookup == FlightLookup::Properties) {
+            return medium.properties(p);
+        } else {
+            MediumProperties mp;
+            mp.sigma_a = medium.extinction(p);
+            return mp;
+        }
+    };
     medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
         double t = seg.tMin;
         double sigma = seg.sigmaMaj;
@@ -77,7 +92,8 @@ FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rn
             }
             t += dt;
             if (seg.decay != 0) sigma = std::min(seg.sigmaMaj * std::exp(-seg.decay * (t - seg.tMin)), 1e300);
-            MediumEvent event{t, ray.at(t), medium.properties(ray.at(t)), sigma};
+            const Vec3 p = ray.at(t);
+            MediumEvent event{t, p, lookup(p), sigma};
             if (!callback(event)) {
                 end = FlightEnd::Stopped;
                 return false;

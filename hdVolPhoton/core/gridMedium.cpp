@@ -455,6 +455,11 @@ double GridMedium::density(const Vec3& p) const {
     return std::min(sampleTrilinear(*m.accessors().acc[DensityField], pi), m.densityCap);
 }
 
+Spectrum GridMedium::extinction(const Vec3& p) const {
+    double d = density(p);
+    return d > 0 ? impl_->sigmaTPerDensity * d : Spectrum(0.0);  // as properties(): 0 where !(d > 0)
+}
+
 MediumProperties GridMedium::properties(const Vec3& p) const {
     MediumProperties mp;
     const Impl& m = *impl_;

@@ -98,6 +98,7 @@ public:
     GridMedium& operator=(const GridMedium&) = delete;
 
     MediumProperties properties(const Vec3& p) const override;
+    Spectrum extinction(const Vec3& p) const override;
     /// Walks the majorant grid in index space: one segment per run of crossed cells with equal
     /// maximum, sigmaMaj = cellMax * densityScale * extinctionColor.maxValue() * (1 + 1e-9) (the
     /// factor absorbs interpolation rounding), decay 0. Empty cells give gaps.

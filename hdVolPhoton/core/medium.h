@@ -98,6 +98,8 @@ public:
     virtual ~Medium() = default;
     /// Local coefficients at p. Outside the medium's support every coefficient is zero.
     virtual MediumProperties properties(const Vec3& p) const = 0;
+    /// sigma_t at p alone, what ratio tracking needs: a grid skips its albedo, emission and lobes.
+    virtual Spectrum extinction(const Vec3& p) const { return properties(p).sigma_t(); }
     /// Calls `segment` for consecutive majorant segments covering the parts of [tMin, tMax] where the
     /// medium may be non-zero, in increasing t. Gaps have zero extinction. Stops when it returns false.
     virtual void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const = 0;

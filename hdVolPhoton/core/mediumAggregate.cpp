@@ -27,6 +27,13 @@ MediumProperties MediumAggregate::properties(const Vec3& p) const {
     return sum;
 }
 
+Spectrum MediumAggregate::extinction(const Vec3& p) const {
+    work::lookups += lookupCost_;
+    Spectrum sum;
+    for (int i = 0; i < count_; ++i) sum += media_[i]->extinction(p);
+    return sum;
+}
+
 namespace {
 /// Upper bound of a segment's majorant over [a, b] (inside the segment).
 double boundOver(const MajorantSegment& s, double a, double b) {

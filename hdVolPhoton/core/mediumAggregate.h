@@ -20,6 +20,7 @@ public:
     const Medium* operator[](int i) const { return media_[i]; }
 
     MediumProperties properties(const Vec3& p) const override;
+    Spectrum extinction(const Vec3& p) const override;
     void majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const override;
     std::optional<Spectrum> opticalDepth(const Ray& ray, double t0, double t1) const override;
     /// Every medium has one.

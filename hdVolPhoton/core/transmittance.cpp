@@ -38,7 +38,7 @@ Spectrum transmittance(const Medium& medium, const Ray& ray, double tMax, Rng& r
 Spectrum ratioTrackingTransmittance(const Medium& medium, const Ray& ray, double tMax, Rng& rng,
                                     const TransmittanceSettings& settings) {
     Spectrum T(1.0);
-    FlightEnd end = sampleFreeFlight(medium, ray, tMax, rng, [&](const MediumEvent& e) {
+    FlightEnd end = sampleFreeFlight<FlightLookup::Extinction>(medium, ray, tMax, rng, [&](const MediumEvent& e) {
         Spectrum sigma_t = e.mp.sigma_t();
         for (int c = 0; c < 3; ++c) T[c] *= std::max(0.0, 1.0 - sigma_t[c] / e.sigmaMaj);
         double Tmax = T.maxValue();

@@ -354,6 +354,43 @@ public:
 };
 }  // namespace
 
+TEST(MediaExtinction, EqualsTheSigmaTOfTheFullProperties) {
+    // extinction() (ratio tracking's lookup, FlightLookup::Extinction) against properties().sigma_t()
+    // at points inside, at the edge of and outside a chromatic VDB cloud with an albedo below 1, an
+    // exponential atmosphere, and their aggregate with a homogeneous box: equal to rounding.
+    std::string path = ::testing::TempDir() + "/media_test_extinction.vdb";
+    writeProceduralCloudVdb(path, 32, 1.0 / 32, 3);
+    GridMediumDesc gd;
+    gd.filePath = path;
+    gd.densityScale = 3.0;
+    gd.extinctionColor = Spectrum(1.0, 0.6, 1.4);
+    gd.albedo = Spectrum(0.3, 0.8, 0.5);
+    auto grid = loadGridMedium(gd);
+    ExponentialMedium air(MediumCoefficients::fromAlbedo(1.0, Spectrum(0.2, 0.5, 1.0), Spectrum(0.9), Spectrum(0.0), makeRayleighPhase()),
+                          0.5, 0.7, Vec3(0, 0, 0), Vec3(0, 1, 0));
+    HomogeneousMedium box(MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.5), Spectrum(0.1), makeIsotropicPhase()),
+                          Bounds3{Vec3(-0.2, -0.2, -0.2), Vec3(0.4, 0.4, 0.4)});
+    MediumAggregate all;
+    all.add(grid.get());
+    all.add(&air);
+    all.add(&box);
+    Bounds3 b = grid->bounds();
+    Rng rng(7);
+    int inside = 0;
+    for (int i = 0; i < 2000; ++i) {
+        Vec3 p;
+        for (int a = 0; a < 3; ++a) p[a] = b.lo[a] + (b.hi[a] - b.lo[a]) * (1.4 * rng.uniform() - 0.2);  // a margin around the cloud
+        for (const Medium* m : {static_cast<const Medium*>(grid.get()), static_cast<const Medium*>(&air),
+                                static_cast<const Medium*>(&all)}) {
+            Spectrum full = m->properties(p).sigma_t(), fast = m->extinction(p);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(fast[c], full[c], 1e-12 * (1 + full[c])) << m->describe() << " at point " << i;
+        }
+        inside += grid->extinction(p)[0] > 0;
+    }
+    EXPECT_GT(inside, 200) << "too few points inside the cloud";
+    EXPECT_LT(inside, 1900) << "too few points outside the cloud";
+}
+
 TEST(MediaFreeFlight, HopelesslyLooseMajorantsEndInsteadOfHanging) {
     LooseMajorant m;
     Rng rng(1);
