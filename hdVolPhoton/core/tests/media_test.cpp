@@ -304,16 +304,24 @@ TEST(MediaValidation, BadParametersThrow) {
 #include "core/gridMedium.h"
 #include "core/proceduralCloud.h"
 
+namespace {
+/// A procedural cloud (32^3 voxels of 1/32, seed 3) written to the test's temporary `file` and
+/// described at density scale 3 with a chromatic extinction colour.
+GridMediumDesc chromaticCloudDesc(const std::string& file) {
+    GridMediumDesc gd;
+    gd.filePath = ::testing::TempDir() + "/" + file;
+    writeProceduralCloudVdb(gd.filePath, 32, 1.0 / 32, 3);
+    gd.densityScale = 3.0;
+    gd.extinctionColor = Spectrum(1.0, 0.6, 1.4);
+    return gd;
+}
+}  // namespace
+
 TEST(MediaTransmittance, RatioTrackingIsUnbiasedOnVdb) {
     // A procedural cloud written and read back as a .vdb file, under a rotation + scale; the
     // reference optical depth is a fine midpoint quadrature of properties() along the ray, which
     // shares nothing with the majorant grid the estimators walk.
-    std::string path = ::testing::TempDir() + "/media_test_cloud.vdb";
-    writeProceduralCloudVdb(path, 32, 1.0 / 32, 3);
-    GridMediumDesc gd;
-    gd.filePath = path;
-    gd.densityScale = 3.0;
-    gd.extinctionColor = Spectrum(1.0, 0.6, 1.4);
+    GridMediumDesc gd = chromaticCloudDesc("media_test_cloud.vdb");
     double c = std::cos(0.4), s = std::sin(0.4);
     gd.objectToWorld.m[0][0] = 1.5 * c; gd.objectToWorld.m[0][2] = 1.5 * s;
     gd.objectToWorld.m[2][0] = -1.5 * s; gd.objectToWorld.m[2][2] = 1.5 * c;
@@ -358,12 +366,7 @@ TEST(MediaExtinction, EqualsTheSigmaTOfTheFullProperties) {
     // extinction() (ratio tracking's lookup, FlightLookup::Extinction) against properties().sigma_t()
     // at points inside, at the edge of and outside a chromatic VDB cloud with an albedo below 1, an
     // exponential atmosphere, and their aggregate with a homogeneous box: equal to rounding.
-    std::string path = ::testing::TempDir() + "/media_test_extinction.vdb";
-    writeProceduralCloudVdb(path, 32, 1.0 / 32, 3);
-    GridMediumDesc gd;
-    gd.filePath = path;
-    gd.densityScale = 3.0;
-    gd.extinctionColor = Spectrum(1.0, 0.6, 1.4);
+    GridMediumDesc gd = chromaticCloudDesc("media_test_extinction.vdb");
     gd.albedo = Spectrum(0.3, 0.8, 0.5);
     auto grid = loadGridMedium(gd);
     ExponentialMedium air(MediumCoefficients::fromAlbedo(1.0, Spectrum(0.2, 0.5, 1.0), Spectrum(0.9), Spectrum(0.0), makeRayleighPhase()),
