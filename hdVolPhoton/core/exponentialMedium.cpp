@@ -69,8 +69,9 @@ void ExponentialMedium::majorants(const Ray& ray, double tMin, double tMax, Majo
     const double decay = b_ * dot(ray.d, up_);                                // d(log density)/dt = -decay
     const double log0 = logA_ - b_ * dot(ray.at(t0) - origin_, up_);  // unclamped, at t0
     auto emit = [&](double ta, double tb, bool clamped, double logStart) {
-        if (clamped) segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(cap), 0.0});
-        else segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(std::min(logStart, cap)), decay});
+        const Spectrum scale = c_.sigma_t() / sigmaMaxChannel_;  // each channel's own majorant
+        if (clamped) segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(cap), 0.0, scale});
+        else segment(MajorantSegment{ta, tb, sigmaMaxChannel_ * std::exp(std::min(logStart, cap)), decay, scale});
     };
     const double tCross = decay != 0 ? t0 + (log0 - cap) / decay : Infinity;  // log density = cap there
     if (tCross > t0 && tCross < t1) {

@@ -11,8 +11,9 @@
 // accumulates tau before t -> infinity (it leaves a decaying atmosphere), so the segment is passed.
 //
 // The majorant is scalar: it bounds sigma_t in every channel. Chromatic media are then unbiased
-// without averaging: callers weight by per-channel ratios (sigma_n,c / sigma_maj for ratio tracking;
-// spectral tracking, Kutz et al. 2017, for scattering paths).
+// without averaging: callers weight by per-channel ratios (sigma_n,c / sigma_maj for ratio tracking).
+// Where a medium knows each channel's own majorant (MajorantSegment::channelScale), a flight of one
+// hero channel (SpectralFlight: the path tracer's spectral MIS) draws from that channel's.
 #pragma once
 
 #include "core/medium.h"
@@ -59,11 +60,30 @@ void warnTruncatedFlight();
 /// dense cloud's CPU time per pass 0.95x, the VDB cloud's and the emissive smoke's unchanged).
 enum class FlightLookup { Properties, Extinction };
 
+/// A flight of one hero channel (the path tracer's spectral MIS): its tentative collisions come from
+/// that channel's own majorant, channelScale[channel] x the scalar one (MajorantSegment), and the
+/// routine reports every channel's majorant, and its optical depth since the previous event, for
+/// the weights. Where all channels share the majorant (grids) the flight is the scalar one.
+struct SpectralFlight {
+    int channel = 0;   ///< in: the hero channel
+    bool chromatic = false;  ///< out: a segment it entered had channels of different majorants; until
+                             ///< then the two below are not kept (every channel has the scalar majorant)
+    Spectrum depth;    ///< out: each channel's majorant optical depth since the previous event (or the
+                       ///< flight's start): at each event up to it, after an escape up to tMax
+    Spectrum sigmaMaj; ///< out: each channel's majorant at the event
+};
+
 /// Draws tentative collisions along ray over (0, tMax) through `medium`'s majorants, calling
 /// callback(const MediumEvent&) -> bool at each, in increasing t. The callback returns false to stop
-/// (a real scattering or absorption).
+/// (a real scattering or absorption). With `spectral`, the collisions are its channel's (above); the
+/// event's sigmaMaj is still the scalar majorant.
 template <FlightLookup Lookup = FlightLookup::Properties, typename Callback>
-FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback) {
+FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rng& rng, Callback&& callback,
+                           SpectralFlight* spectral = nullptr) {
+    if (spectral) {
+        spectral->depth = Spectrum(0.0);
+        spectral->chromatic = false;
+    }
     FlightEnd end = FlightEnd::Escaped;
     int64_t events = 0;
     auto lookup = [&medium](const Vec3& p) {
@@ -78,13 +98,25 @@ FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rn
     medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
         double t = seg.tMin;
         double sigma = seg.sigmaMaj;
+        // The hero channel's share of the scalar majorant (1 without `spectral`).
+        double heroScale = 1.0;
+        if (spectral) {
+            heroScale = seg.channelScale[spectral->channel];
+            spectral->chromatic |= !(seg.channelScale[0] == seg.channelScale[1] && seg.channelScale[1] == seg.channelScale[2]);
+        }
         while (true) {
             // Exp(1). uniform() < 1 keeps it finite, and 1 - u is exact (u is a multiple of 2^-53,
             // Rng::uniform): log(1 - u) is log1p(-u) to rounding, at half its cost (9.5% of a dense
             // cloud's render time went to log1p here).
             double tau = -std::log(1.0 - rng.uniform());
-            double dt = invertMajorantDepth(tau, sigma, seg.decay);
-            if (!(dt < seg.tMax - t)) return true;  // passed the segment: on to the next one
+            double dt = invertMajorantDepth(tau, sigma * heroScale, seg.decay);
+            if (!(dt < seg.tMax - t)) {  // passed the segment: on to the next one
+                if (spectral && spectral->chromatic) {
+                    MajorantSegment rest{t, seg.tMax, sigma, seg.decay};
+                    spectral->depth += seg.channelScale * rest.opticalDepth(seg.tMax - t);
+                }
+                return true;
+            }
             if (++events > MaxTentativeCollisions) {
                 warnTruncatedFlight();
                 end = FlightEnd::Truncated;
@@ -92,9 +124,16 @@ FlightEnd sampleFreeFlight(const Medium& medium, const Ray& ray, double tMax, Rn
             }
             t += dt;
             if (seg.decay != 0) sigma = std::min(seg.sigmaMaj * std::exp(-seg.decay * (t - seg.tMin)), 1e300);
+            const bool chromatic = spectral && spectral->chromatic;
+            if (chromatic) {
+                spectral->depth += seg.channelScale * (tau / heroScale);
+                spectral->sigmaMaj = seg.channelScale * sigma;
+            }
             const Vec3 p = ray.at(t);
             MediumEvent event{t, p, lookup(p), sigma};
-            if (!callback(event)) {
+            const bool goOn = callback(event);
+            if (chromatic) spectral->depth = Spectrum(0.0);
+            if (!goOn) {
                 end = FlightEnd::Stopped;
                 return false;
             }
@@ -110,6 +149,20 @@ inline double majorantDepth(const Medium& medium, const Ray& ray, double tMax, d
     medium.majorants(ray, 0.0, tMax, [&](const MajorantSegment& seg) {
         total += seg.opticalDepth(std::min(seg.tMax, tMax) - seg.tMin);
         return total < stopAt;
+    });
+    return total;
+}
+
+/// Each channel's majorant optical depth over (t0, t1) (MajorantSegment::channelScale).
+inline Spectrum channelMajorantDepth(const Medium& medium, const Ray& ray, double t0, double t1) {
+    Spectrum total(0.0);
+    medium.majorants(ray, t0, t1, [&](const MajorantSegment& seg) {
+        double a = std::max(seg.tMin, t0), b = std::min(seg.tMax, t1);
+        if (b > a) {
+            double sigma = seg.decay == 0 ? seg.sigmaMaj : seg.sigmaMaj * std::exp(-seg.decay * (a - seg.tMin));
+            total += seg.channelScale * MajorantSegment{a, b, sigma, seg.decay}.opticalDepth(b - a);
+        }
+        return true;
     });
     return total;
 }

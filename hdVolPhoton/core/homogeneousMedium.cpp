@@ -54,7 +54,7 @@ MediumProperties HomogeneousMedium::properties(const Vec3& p) const {
 void HomogeneousMedium::majorants(const Ray& ray, double tMin, double tMax, MajorantCallback segment) const {
     double t0, t1;
     if (sigmaMaj_ == 0 || !bounds_.intersect(ray, tMin, tMax, &t0, &t1)) return;
-    segment(MajorantSegment{t0, t1, sigmaMaj_, 0.0});
+    segment(MajorantSegment{t0, t1, sigmaMaj_, 0.0, c_.sigma_t() / sigmaMaj_});
 }
 
 std::optional<Spectrum> HomogeneousMedium::opticalDepth(const Ray& ray, double t0, double t1) const {

@@ -81,6 +81,12 @@ struct MajorantSegment {
     double tMin = 0, tMax = 0;
     double sigmaMaj = 0;
     double decay = 0;
+    /// Each channel's own majorant over the piece is channelScale[c] x the scalar one (components in
+    /// [0, 1]): a homogeneous or exponential medium's sigma_t over its largest channel, 1 where the
+    /// majorant bounds all channels alike (grids, overlaps). The path tracer's hero-channel flights
+    /// draw their tentative collisions from their channel's own majorant (sampleFreeFlight,
+    /// SpectralFlight), so in a chromatic homogeneous medium they meet no null collisions.
+    Spectrum channelScale{1.0};
     /// The majorant's optical depth over the first `len` of the piece: sigmaMaj len (1 - e^{-x}) / x,
     /// x = decay len (expm1: exact as x -> 0).
     double opticalDepth(double len) const {

@@ -83,7 +83,7 @@ void MediumAggregate::majorants(const Ray& ray, double tMin, double tMax, Majora
         if (n == 1) {
             const MajorantSegment& s = *covering[0];
             double start = s.decay == 0 ? s.sigmaMaj : s.sigmaMaj * std::exp(std::min(-s.decay * (a - s.tMin), 700.0));
-            if (!segment(MajorantSegment{a, b, start, s.decay})) return;
+            if (!segment(MajorantSegment{a, b, start, s.decay, s.channelScale})) return;
             continue;
         }
         int pieces = 1;

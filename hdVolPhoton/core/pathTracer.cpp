@@ -1,12 +1,14 @@
 // Integrator 1: the unbiased volumetric path tracer (the reference).
 //
-// Free flights come from sampleFreeFlight() with a scalar majorant; the event at each tentative
-// collision is chosen by spectral tracking with history-aware probabilities (Kutz, Habel, Li and
-// Novak 2017, "Spectral and Decomposition Tracking for Rendering Heterogeneous Volumes", sec. 5),
-// with absorption and scattering merged into one real collision that always scatters:
-//   P_c ~ avg(sigma_t beta), P_n ~ avg(sigma_n beta), sigma_n = sigma_maj - sigma_t,
-// and the throughput beta is multiplied by sigma_s / (sigma_maj P_c) or sigma_n / (sigma_maj P_n),
-// which keeps every RGB channel unbiased in chromatic media without averaging. (An analog absorption
+// Free flights come from sampleFreeFlight(), drawn by the path's hero channel from its own majorant
+// (in homogeneous and exponential media its own sigma_t: no null collisions); the event at each
+// tentative collision is real with probability sigma_t / sigma_maj of the hero, absorption and
+// scattering merged into one real collision that always scatters, and every channel is weighted by
+// spectral MIS over the path (Miller, Georgiev and Jarosz 2019; SpectralMis below), which keeps every
+// RGB channel unbiased with weights bounded by the albedo. It replaced spectral tracking with
+// history-aware probabilities under the channels' largest majorant (Kutz, Habel, Li and Novak 2017,
+// sec. 5): per-sample variance on the marble figurine (benchmark scene 9) 0.69x at 1.09x the CPU time
+// (tools/bench/README.md, "Hero channels"). (An analog absorption
 // event, ending the path with probability ~ sigma_a / sigma_t, had 2.4x Mitsuba's per-sample variance
 // on benchmark scene 1; the albedo as a weight plus roulette is what Mitsuba's volpath does.) Volume emission along each
 // segment is estimated by ratio tracking over the whole segment (ratioTrackedEmission), apart from
@@ -98,6 +100,10 @@ public:
         // the collision where the path scatters (read only when `scattered`), the flight sampled first.
         MediumEvent scatter;
         EarlyFlight early;
+        SpectralMis mis;
+        mis.hero = rng.pathChoice(3);
+        SpectralFlight flight;  // the hero's flights
+        flight.channel = mis.hero;
         double segmentCollisionP = 0, segmentTake = 0;  // segmentLight: the flight's collision probability, the strategy's
         for (int segment = 0;; ++segment) {
             rng.startSegment(segment);
@@ -138,7 +144,7 @@ public:
             flightFirst &= !segmentLight;
             if (flightFirst) {
                 rng.event(Rng::Event::Flight);
-                flyEarly(media, local, rayLength, beta, rng, &early, &scatter);
+                flyEarly(media, local, rayLength, beta, mis, rng, &early, &scatter);
             }
             const bool collidedEarly = flightFirst && early.stop == EarlyFlight::Stop::Collided;
             PathSegment ahead = nextSegment(path, stack, firstSegment, collidedEarly ? mediumFrom + early.t : Infinity);
@@ -147,7 +153,7 @@ public:
             const double length = std::isinf(tEnd) ? 1e30 : tEnd - mediumFrom;
             // One tentative collision of the camera path's flight; false when it stopped there.
             auto collide = [&](const MediumEvent& e, double from) {
-                Collision c = spectralTracking(e, beta, rng);
+                Collision c = spectralTracking(e, flight, beta, mis, rng);
                 if (c == Collision::Null) return true;
                 if (c == Collision::Scatter) {
                     scatter = e;
@@ -191,6 +197,7 @@ public:
                         if (collidedEarly && tEnd == mediumFrom + early.t) {
                             // Nothing met before the flight stopped: its collision (in `scatter`) stands.
                             beta = early.beta;
+                            mis = early.mis;
                             if (early.scattered) {
                                 scatter.t += mediumFrom;
                                 scattered = true;
@@ -201,19 +208,23 @@ public:
                             // The segment ends first: the null collisions before its end, then
                             // (where the flight stopped early and the segment goes on) the rest of
                             // the flight from there, a free flight being memoryless.
-                            beta = early.betaBefore(length, beta);
+                            double last = early.restoreBefore(length, &beta, &mis);
                             if (early.stop == EarlyFlight::Stop::Bailed && early.t < length) {
                                 const double from = mediumFrom + early.t;
-                                FlightEnd end = sampleFreeFlight(media, Ray{local.at(early.t), local.d}, length - early.t,
-                                                                 rng, [&](const MediumEvent& e) { return collide(e, from); });
-                                absorbed |= end == FlightEnd::Truncated;
+                                FlightEnd end = sampleFreeFlight(
+                                    media, Ray{local.at(early.t), local.d}, length - early.t, rng,
+                                    [&](const MediumEvent& e) { return collide(e, from); }, &flight);
+                                absorbed |= end == FlightEnd::Truncated || (end == FlightEnd::Escaped && !mis.escape(flight.depth, beta));
+                            } else if (early.chromatic) {
+                                // No tentative collision of the hero between the last null and the end.
+                                absorbed |= !mis.escape(channelMajorantDepth(media, local, last, length), beta);
                             }
                         }
                     } else {
                         rng.event(Rng::Event::Flight);
-                        FlightEnd end = sampleFreeFlight(media, local, length, rng,
-                                                         [&](const MediumEvent& e) { return collide(e, mediumFrom); });
-                        absorbed |= end == FlightEnd::Truncated;
+                        FlightEnd end = sampleFreeFlight(
+                            media, local, length, rng, [&](const MediumEvent& e) { return collide(e, mediumFrom); }, &flight);
+                        absorbed |= end == FlightEnd::Truncated || (end == FlightEnd::Escaped && !mis.escape(flight.depth, beta));
                     }
                     if (photonShare > 0) {
                         // The photons' estimate along the whole segment, whatever the flight did:
@@ -348,23 +359,70 @@ private:
     bool isPointLight(int i) const { return i >= 0 && pointLight_[i]; }
 
     enum class Collision { Null, Scatter, Absorb };
-    /// Spectral tracking's choice at one tentative collision (the header's P_c and P_n), with beta
-    /// updated: a real collision scatters with the albedo as a weight (sigma_s in the phase kernel)
-    /// instead of ending the path with probability sigma_a / sigma_t; Russian roulette ends
-    /// low-throughput paths later.
-    static Collision spectralTracking(const MediumEvent& e, Spectrum& beta, Rng& rng) {
-        Spectrum sigma_n = Spectrum(e.sigmaMaj) - e.mp.sigma_t();
-        for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
-        double pc = (e.mp.sigma_t() * beta).average(), pn = (sigma_n * beta).average();
-        double total = pc + pn;
-        if (!(total > 0)) return Collision::Absorb;
-        if (rng.uniform() * total < pc) {
-            if (e.mp.sigma_s.isBlack()) return Collision::Absorb;
-            beta *= total / (e.sigmaMaj * pc);
-            return Collision::Scatter;
+    /// Spectral MIS over the path (Miller, Georgiev and Jarosz 2019, "A null-scattering path integral
+    /// formulation of light transport", sec. 5.2; pbrt-v4's VolPathIntegrator keeps the same ratios
+    /// as r_u): a path's flights are its hero channel's h, picked once per path (Rng::pathChoice), from
+    /// that channel's own majorant (SpectralFlight: in a homogeneous or exponential medium its own
+    /// sigma_t, so no null collisions) and with its real/null choices; channel c is weighted by
+    /// f_c / avg_j p_j over the path, p_j the density of the same flights had channel j made them. r
+    /// holds p_j / p_h normalised to average one, so beta stays the path's weight as everything else
+    /// uses it (next-event estimates, roulette); an event with per-channel contribution f and density
+    /// d multiplies beta by f / avg(r d) and r by d / avg(r d). The weight of channel c is at most
+    /// 3 f_c / p_c = 3 prod(albedo_c) however long the walk.
+    struct SpectralMis {
+        int hero = 0;
+        Spectrum r{1.0};
+        /// The event with contributions f and densities d (per channel).
+        bool apply(const Spectrum& f, const Spectrum& d, Spectrum& beta) {
+            Spectrum rd = r * d;
+            double avg = rd.average();
+            if (!(avg > 0) || !std::isfinite(avg)) return false;
+            beta *= f / avg;
+            r = rd / avg;
+            return true;
         }
-        beta *= sigma_n * (total / (e.sigmaMaj * pn));
-        return Collision::Null;
+        /// A flight that left its segment after each channel's majorant optical depth `depth`: f = d =
+        /// e^-depth (relative to the smallest, which cancels). False: nothing can pass.
+        bool escape(const Spectrum& depth, Spectrum& beta) {
+            if (depth[0] == depth[1] && depth[1] == depth[2]) return std::isfinite(depth[0]);
+            double m = depth.minValue();
+            if (!std::isfinite(m)) return false;
+            Spectrum q;
+            for (int k = 0; k < 3; ++k) q[k] = depth[k] == m ? 1.0 : std::exp(m - depth[k]);
+            return apply(q, q, beta);
+        }
+    };
+    /// One tentative collision of the hero's flight (sf: each channel's majorant there and its optical
+    /// depth since the previous event), with beta and mis.r updated: a real collision scatters with
+    /// the albedo as a weight (sigma_s in the phase kernel) instead of ending the path with probability
+    /// sigma_a / sigma_t; Russian roulette ends low-throughput paths later. Real with probability
+    /// sigma_t / sigma_maj of the hero; in grey media (one majorant, one sigma_t) every channel makes
+    /// the same choice with the same density, and r is unchanged.
+    static Collision spectralTracking(const MediumEvent& e, const SpectralFlight& sf, Spectrum& beta, SpectralMis& mis, Rng& rng) {
+        const Spectrum sigma_t = e.mp.sigma_t();
+        const int h = mis.hero;
+        const double majH = sf.chromatic ? sf.sigmaMaj[h] : e.sigmaMaj;
+        const double pc = std::min(1.0, sigma_t[h] / majH);
+        const bool real = rng.uniform() < pc;
+        if (real && e.mp.sigma_s.isBlack()) return Collision::Absorb;
+        if (!sf.chromatic && sigma_t[0] == sigma_t[1] && sigma_t[1] == sigma_t[2]) {
+            if (real) beta *= 1 / (majH * pc);
+            return real ? Collision::Scatter : Collision::Null;
+        }
+        Spectrum f, d;  // per channel: the event's contribution and density, both over e^-(majorant depth)
+        const double m = sf.chromatic ? sf.depth.minValue() : 0.0;
+        for (int k = 0; k < 3; ++k) {
+            double q = 1, maj = e.sigmaMaj;
+            if (sf.chromatic) {
+                q = sf.depth[k] == m ? 1.0 : std::exp(m - sf.depth[k]);
+                maj = sf.sigmaMaj[k];
+            }
+            double s = std::min(sigma_t[k], maj);
+            f[k] = real ? q : q * (maj - s);
+            d[k] = real ? q * s : f[k];
+        }
+        if (!mis.apply(f, d, beta)) return Collision::Absorb;
+        return real ? Collision::Scatter : Collision::Null;
     }
 
     /// A flight sampled before the surfaces ahead are searched, from a medium collision (Mitsuba 3's
@@ -381,26 +439,35 @@ private:
         double t = Infinity;     ///< where it stopped (along the local ray)
         bool scattered = false;  ///< Collided: it scatters (else it absorbs)
         Spectrum beta;           ///< the throughput after its last event
+        SpectralMis mis;         ///< and the path's spectral MIS ratios
+        bool chromatic = false;  ///< it met channels of different majorants (SpectralFlight::chromatic)
         int nulls = 0;
         double nullT[MaxNulls];
-        double nullBeta[MaxNulls][3];  // not Spectrum: no zeroing of the log on every segment
+        double nullBeta[MaxNulls][3], nullR[MaxNulls][3];  // not Spectrum: no zeroing of the log on every segment
 
-        /// The throughput after the null collisions before distance t, from `start`.
-        Spectrum betaBefore(double t, const Spectrum& start) const {
-            Spectrum b = start;
-            for (int i = 0; i < nulls && nullT[i] < t; ++i) b = Spectrum(nullBeta[i][0], nullBeta[i][1], nullBeta[i][2]);
-            return b;
+        /// The throughput and MIS ratios after the null collisions before distance t (unchanged
+        /// where there are none); returns the last one's distance (0 if none).
+        double restoreBefore(double t, Spectrum* beta, SpectralMis* m) const {
+            int i = 0;
+            while (i < nulls && nullT[i] < t) ++i;
+            if (i == 0) return 0;
+            *beta = Spectrum(nullBeta[i - 1][0], nullBeta[i - 1][1], nullBeta[i - 1][2]);
+            m->r = Spectrum(nullR[i - 1][0], nullR[i - 1][1], nullR[i - 1][2]);
+            return nullT[i - 1];
         }
     };
     /// Samples *f from scratch; a collision it stops at goes to *collision (t along `local`).
-    static void flyEarly(const Medium& media, const Ray& local, double length, const Spectrum& beta, Rng& rng,
-                         EarlyFlight* f, MediumEvent* collision) {
+    static void flyEarly(const Medium& media, const Ray& local, double length, const Spectrum& beta,
+                         const SpectralMis& mis, Rng& rng, EarlyFlight* f, MediumEvent* collision) {
         f->stop = EarlyFlight::Stop::None;
         f->t = Infinity;
         f->beta = beta;
+        f->mis = mis;
         f->nulls = 0;
+        SpectralFlight flight;
+        flight.channel = mis.hero;
         sampleFreeFlight(media, local, length, rng, [&](const MediumEvent& e) {
-            Collision c = spectralTracking(e, f->beta, rng);
+            Collision c = spectralTracking(e, flight, f->beta, f->mis, rng);
             f->t = e.t;
             if (c != Collision::Null) {
                 f->stop = EarlyFlight::Stop::Collided;
@@ -409,13 +476,17 @@ private:
                 return false;
             }
             f->nullT[f->nulls] = e.t;
-            for (int k = 0; k < 3; ++k) f->nullBeta[f->nulls][k] = f->beta[k];
+            for (int k = 0; k < 3; ++k) {
+                f->nullBeta[f->nulls][k] = f->beta[k];
+                f->nullR[f->nulls][k] = f->mis.r[k];
+            }
             if (++f->nulls == EarlyFlight::MaxNulls) {
                 f->stop = EarlyFlight::Stop::Bailed;
                 return false;
             }
             return true;
-        });
+        }, &flight);
+        f->chromatic = flight.chromatic;
     }
 
     static constexpr double EmissionRouletteBelow = 0.2;

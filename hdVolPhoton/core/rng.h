@@ -184,6 +184,21 @@ public:
         }
         return 0;
     }
+    /// One of n choices for a whole path (the path tracer's hero channel), drawn outside every
+    /// dimension the draws above use. Under stratify() it is an Owen-scrambled van der Corput point
+    /// of the sample index (its own scramble), so a pixel's passes take the n choices in near-equal
+    /// numbers; otherwise PCG32.
+    int pathChoice(int n) {
+        uint32_t v;
+        if (qmcDims_ > 0) {
+            uint64_t h = mix64(qmcKey_ ^ 0x68e7a1c35b2f9d01ULL);
+            v = owenScramble(sobol0(reverseBits32(qmcIndexReversed_)), static_cast<uint32_t>(h));
+        } else {
+            v = nextU32();
+        }
+        return std::min(n - 1, static_cast<int>((static_cast<uint64_t>(v) * static_cast<uint64_t>(n)) >> 32));
+    }
+
     void startSegment(int segment) {
         if (qmcDims_ <= 0) return;
         segmentBase_ = CameraDims + SegmentDims * segment;
