@@ -5,6 +5,7 @@
 
 #include <functional>
 
+#include "core/freeFlight.h"
 #include "core/functionRef.h"
 #include "core/integrator.h"
 #include "core/rng.h"
@@ -48,6 +49,65 @@ inline double rouletteSurvival(double betaMax, int depth) {
 }
 
 /// Outcome of scattering at a surface for a path arriving along direction d.
+/// Spectral MIS over a path (Miller, Georgiev and Jarosz 2019, "A null-scattering path integral
+/// formulation of light transport", sec. 5.2; pbrt-v4's VolPathIntegrator keeps the same ratios as
+/// r_u), for camera paths (pathTracer.cpp) and photons (photonMapper.cpp): a path's flights are its
+/// hero channel's, picked once per path (Rng::pathChoice), from that channel's own majorant
+/// (SpectralFlight: in a homogeneous or exponential medium its own sigma_t, so no null collisions)
+/// and with its choices at tentative collisions; channel c is weighted by f_c / avg_j p_j over the
+/// path, p_j the density of the same flights and choices had channel j made them. r holds p_j / p_h
+/// normalised to average one, so the path's weight (beta, a photon's flux) stays what everything
+/// else uses (next-event estimates, roulette, stored photons); an event with per-channel
+/// contribution f and density d multiplies the weight by f / avg(r d) and r by d / avg(r d). The
+/// weight of channel c is at most 3 f_c / p_c = 3 prod(albedo_c) however long the walk.
+struct SpectralMis {
+    int hero = 0;
+    Spectrum r{1.0};
+    /// The event with contributions f and densities d (per channel); false if no channel could have
+    /// made it.
+    bool apply(const Spectrum& f, const Spectrum& d, Spectrum& weight) {
+        Spectrum rd = r * d;
+        double avg = rd.average();
+        if (!(avg > 0) || !std::isfinite(avg)) return false;
+        weight *= f / avg;
+        r = rd / avg;
+        return true;
+    }
+    /// A tentative collision of the hero's flight (sf: each channel's majorant there and its optical
+    /// depth since the previous event) with extinction sigma_t: a real one, taken with probability
+    /// *real / sigma_maj (sigma_t where it always scatters, sigma_s where absorption ends paths; its
+    /// kernel, sigma_s, is the caller's), or a null one (real == nullptr). Densities and
+    /// contributions are both over e^-(majorant depth), relative to the smallest depth, which cancels.
+    bool collide(const MediumEvent& e, const SpectralFlight& sf, const Spectrum& sigma_t, const Spectrum* real, Spectrum& weight) {
+        Spectrum f, d;
+        const double m = sf.chromatic ? sf.depth.minValue() : 0.0;
+        for (int k = 0; k < 3; ++k) {
+            double q = 1, maj = e.sigmaMaj;
+            if (sf.chromatic) {
+                q = sf.depth[k] == m ? 1.0 : std::exp(m - sf.depth[k]);
+                maj = sf.sigmaMaj[k];
+            }
+            if (real) {
+                f[k] = q;
+                d[k] = q * std::min((*real)[k], maj);
+            } else {
+                f[k] = d[k] = q * (maj - std::min(sigma_t[k], maj));
+            }
+        }
+        return apply(f, d, weight);
+    }
+    /// A flight that left its segment after each channel's majorant optical depth `depth` (f = d =
+    /// e^-depth); false if nothing can pass.
+    bool escape(const Spectrum& depth, Spectrum& weight) {
+        if (depth[0] == depth[1] && depth[1] == depth[2]) return std::isfinite(depth[0]);
+        double m = depth.minValue();
+        if (!std::isfinite(m)) return false;
+        Spectrum q;
+        for (int k = 0; k < 3; ++k) q[k] = depth[k] == m ? 1.0 : std::exp(m - depth[k]);
+        return apply(q, q, weight);
+    }
+};
+
 struct SurfaceScatter {
     enum class Type { Absorbed, Diffuse, Specular, Pass };
     Type type = Type::Absorbed;

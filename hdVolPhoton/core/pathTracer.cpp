@@ -4,7 +4,7 @@
 // (in homogeneous and exponential media its own sigma_t: no null collisions); the event at each
 // tentative collision is real with probability sigma_t / sigma_maj of the hero, absorption and
 // scattering merged into one real collision that always scatters, and every channel is weighted by
-// spectral MIS over the path (Miller, Georgiev and Jarosz 2019; SpectralMis below), which keeps every
+// spectral MIS over the path (Miller, Georgiev and Jarosz 2019; SpectralMis, integratorBase.h), which keeps every
 // RGB channel unbiased with weights bounded by the albedo. It replaced spectral tracking with
 // history-aware probabilities under the channels' largest majorant (Kutz, Habel, Li and Novak 2017,
 // sec. 5): per-sample variance on the marble figurine (benchmark scene 9) 0.69x at 1.09x the CPU time
@@ -359,39 +359,6 @@ private:
     bool isPointLight(int i) const { return i >= 0 && pointLight_[i]; }
 
     enum class Collision { Null, Scatter, Absorb };
-    /// Spectral MIS over the path (Miller, Georgiev and Jarosz 2019, "A null-scattering path integral
-    /// formulation of light transport", sec. 5.2; pbrt-v4's VolPathIntegrator keeps the same ratios
-    /// as r_u): a path's flights are its hero channel's h, picked once per path (Rng::pathChoice), from
-    /// that channel's own majorant (SpectralFlight: in a homogeneous or exponential medium its own
-    /// sigma_t, so no null collisions) and with its real/null choices; channel c is weighted by
-    /// f_c / avg_j p_j over the path, p_j the density of the same flights had channel j made them. r
-    /// holds p_j / p_h normalised to average one, so beta stays the path's weight as everything else
-    /// uses it (next-event estimates, roulette); an event with per-channel contribution f and density
-    /// d multiplies beta by f / avg(r d) and r by d / avg(r d). The weight of channel c is at most
-    /// 3 f_c / p_c = 3 prod(albedo_c) however long the walk.
-    struct SpectralMis {
-        int hero = 0;
-        Spectrum r{1.0};
-        /// The event with contributions f and densities d (per channel).
-        bool apply(const Spectrum& f, const Spectrum& d, Spectrum& beta) {
-            Spectrum rd = r * d;
-            double avg = rd.average();
-            if (!(avg > 0) || !std::isfinite(avg)) return false;
-            beta *= f / avg;
-            r = rd / avg;
-            return true;
-        }
-        /// A flight that left its segment after each channel's majorant optical depth `depth`: f = d =
-        /// e^-depth (relative to the smallest, which cancels). False: nothing can pass.
-        bool escape(const Spectrum& depth, Spectrum& beta) {
-            if (depth[0] == depth[1] && depth[1] == depth[2]) return std::isfinite(depth[0]);
-            double m = depth.minValue();
-            if (!std::isfinite(m)) return false;
-            Spectrum q;
-            for (int k = 0; k < 3; ++k) q[k] = depth[k] == m ? 1.0 : std::exp(m - depth[k]);
-            return apply(q, q, beta);
-        }
-    };
     /// One tentative collision of the hero's flight (sf: each channel's majorant there and its optical
     /// depth since the previous event), with beta and mis.r updated: a real collision scatters with
     /// the albedo as a weight (sigma_s in the phase kernel) instead of ending the path with probability
@@ -409,19 +376,7 @@ private:
             if (real) beta *= 1 / (majH * pc);
             return real ? Collision::Scatter : Collision::Null;
         }
-        Spectrum f, d;  // per channel: the event's contribution and density, both over e^-(majorant depth)
-        const double m = sf.chromatic ? sf.depth.minValue() : 0.0;
-        for (int k = 0; k < 3; ++k) {
-            double q = 1, maj = e.sigmaMaj;
-            if (sf.chromatic) {
-                q = sf.depth[k] == m ? 1.0 : std::exp(m - sf.depth[k]);
-                maj = sf.sigmaMaj[k];
-            }
-            double s = std::min(sigma_t[k], maj);
-            f[k] = real ? q : q * (maj - s);
-            d[k] = real ? q * s : f[k];
-        }
-        if (!mis.apply(f, d, beta)) return Collision::Absorb;
+        if (!mis.collide(e, sf, sigma_t, real ? &sigma_t : nullptr, beta)) return Collision::Absorb;
         return real ? Collision::Scatter : Collision::Null;
     }
 

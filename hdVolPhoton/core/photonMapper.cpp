@@ -843,6 +843,10 @@ private:
         if (flux.isBlack() || !flux.isFinite()) return;
         MediumStack stack = hasMeshMedia_ ? scene_.stackAt(ray.o) : MediumStack();
         MediumEvent ev;  // where the photon scatters (read only when `scattered`); built once per photon
+        SpectralMis mis;
+        mis.hero = rng.pathChoice(3);
+        SpectralFlight flight;  // the hero's flights
+        flight.channel = mis.hero;
         for (int depth = 0, crossings = 0; depth <= settings_.maxDepth && crossings < MaxBoundaryCrossings;) {
             SurfaceHit hit;
             bool hasHit = scene_.intersect(ray, path.tMin, Infinity, &hit);
@@ -862,28 +866,43 @@ private:
                     if (beams) addBeamPiece(ray, pieceStart, t1, flux, media, region, cap, &out->beams);
                     pieceStart = t1;
                 };
+                // The hero channel's flight (SpectralMis): absorption, scattering and null collisions
+                // with its probabilities sigma_a, sigma_s and sigma_n over its majorant.
                 FlightEnd end = sampleFreeFlight(media, ray, tEnd, rng, [&](const MediumEvent& m) {
                     sigmaMaj = m.sigmaMaj;
-                    Spectrum sigma_n = Spectrum(m.sigmaMaj) - m.mp.sigma_t();
-                    for (int c = 0; c < 3; ++c) sigma_n[c] = std::max(0.0, sigma_n[c]);
-                    double pa = (m.mp.sigma_a * flux).average(), ps = (m.mp.sigma_s * flux).average();
-                    double pn = (sigma_n * flux).average(), total = pa + ps + pn;
-                    if (!(total > 0)) { absorbed = true; addBeam(m.t); return false; }
-                    double x = rng.uniform() * total;
-                    if (x < pa) { absorbed = true; addBeam(m.t); return false; }
-                    if (x < pa + ps) {
+                    const int h = mis.hero;
+                    const double maj = flight.chromatic ? flight.sigmaMaj[h] : m.sigmaMaj;
+                    const Spectrum sigma_t = m.mp.sigma_t();
+                    const double x = rng.uniform() * maj;
+                    if (x < m.mp.sigma_a[h]) { absorbed = true; addBeam(m.t); return false; }
+                    const Spectrum& sigma_s = m.mp.sigma_s;
+                    const bool grey = !flight.chromatic && sigma_t[0] == sigma_t[1] && sigma_t[1] == sigma_t[2] &&
+                                      sigma_s[0] == sigma_s[1] && sigma_s[1] == sigma_s[2];
+                    if (x < sigma_t[h]) {
                         addBeam(m.t);
-                        flux *= total / (m.sigmaMaj * ps);
+                        // grey: every channel makes the same choice, and flux takes 1 / sigma_s
+                        if (grey ? sigma_s.isBlack() : !mis.collide(m, flight, sigma_t, &sigma_s, flux)) {
+                            absorbed = true;
+                            return false;
+                        }
+                        if (grey) flux *= 1 / sigma_s[h];
                         ev = m;
                         scattered = true;
                         return false;
                     }
-                    Spectrum weight = sigma_n * (total / (m.sigmaMaj * pn));
-                    if (beams && std::abs(weight.maxValue() - 1) + std::abs(weight.minValue() - 1) > 1e-6) addBeam(m.t);
-                    flux *= weight;
+                    if (grey) return true;  // a null collision of the same weight in every channel
+                    const Spectrum before = flux;
+                    if (!mis.collide(m, flight, sigma_t, nullptr, flux)) { absorbed = true; addBeam(m.t); return false; }
+                    if (beams && (flux - before).maxValue() + (before - flux).maxValue() > 1e-6 * before.maxValue()) {
+                        // The weight changed: the piece so far carries the flux before it.
+                        Spectrum after = flux;
+                        flux = before;
+                        addBeam(m.t);
+                        flux = after;
+                    }
                     return true;
-                });
-                absorbed |= end == FlightEnd::Truncated;
+                }, &flight);
+                absorbed |= end == FlightEnd::Truncated || (end == FlightEnd::Escaped && !mis.escape(flight.depth, flux));
                 if (end == FlightEnd::Escaped) addBeam(tEnd);
             }
             if (absorbed) return;
@@ -914,7 +933,7 @@ private:
                 Vec3 w = mp.sampleScatter(ray.d, rng.uniform(), rng.uniform(), rng.uniform());
                 double cosTheta = dot(ray.d, w), pdf = mp.scatterPdf(cosTheta);
                 if (!(pdf > 0)) return;
-                // flux carries 1/(sigma_maj P_s) from spectral tracking; the kernel brings sigma_s.
+                // flux carries 1/sigma_s (and the spectral MIS weights); the kernel brings sigma_s.
                 flux *= mp.scatterKernel(cosTheta) / pdf;
                 for (int c = 0; c < 3; ++c) if (!std::isfinite(flux[c])) flux[c] = 0;
                 path.bounce({ev.p, w}, 0.0);

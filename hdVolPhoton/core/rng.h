@@ -187,14 +187,15 @@ public:
     /// One of n choices for a whole path (the path tracer's hero channel), drawn outside every
     /// dimension the draws above use. Under stratify() it is an Owen-scrambled van der Corput point
     /// of the sample index (its own scramble), so a pixel's passes take the n choices in near-equal
-    /// numbers; otherwise PCG32.
+    /// numbers; otherwise a hash of PCG32's state, which it leaves as it was.
     int pathChoice(int n) {
         uint32_t v;
         if (qmcDims_ > 0) {
             uint64_t h = mix64(qmcKey_ ^ 0x68e7a1c35b2f9d01ULL);
             v = owenScramble(sobol0(reverseBits32(qmcIndexReversed_)), static_cast<uint32_t>(h));
         } else {
-            v = nextU32();
+            // A hash of the state, which is not advanced: the stream's draws stay as they were.
+            v = static_cast<uint32_t>(mix64(state_ ^ inc_ ^ 0x68e7a1c35b2f9d01ULL) >> 32);
         }
         return std::min(n - 1, static_cast<int>((static_cast<uint64_t>(v) * static_cast<uint64_t>(n)) >> 32));
     }

@@ -135,8 +135,11 @@ TEST(IntegratorFurnace, ChromaticExponentialMedium) {
     for (int ch = 0; ch < 3; ++ch)
         expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PathTracer, 8, 0), Film::Beauty, ch, 64), 1.0, 5, 1e-9,
                          "exponential furnace channel " + std::to_string(ch));
+    // The photon map's estimate is as heavy-tailed here (per-pixel standard errors over 16 seeds from
+    // 0.001 to 0.05 between disjoint seed sets, with spectral tracking's photons and with the hero
+    // channels' alike): 64 seeds for it too.
     for (int ch = 0; ch < 3; ++ch)
-        expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0), Film::Beauty, ch), 1.0, 5, 0.02,
+        expectEveryPixel(renderSeeds(make, smallSettings(RenderSettings::Integrator::PhotonMap, 4, 0), Film::Beauty, ch, 64), 1.0, 5, 0.02,
                          "photon map exponential furnace channel " + std::to_string(ch));
 }
 
@@ -921,12 +924,15 @@ TEST(IntegratorAgreement, PhotonSinglePlusMultipleEqualsPathTracerBeauty) {
 }
 
 TEST(IntegratorAgreement, PhotonBeamsAgreeWithThePathTracerAndPhotonPoints) {
-    // Chromatic fog (spectral-tracking weights split beams), a distant and a sphere light, and a floor
-    // (beams after a diffuse bounce): the beams' multiple scattering must match the path tracer's.
+    // Chromatic fog (spectral MIS weights split beams at null collisions), a distant and a sphere
+    // light, and a floor (beams after a diffuse bounce): the beams' multiple scattering must match the
+    // path tracer's. 32 passes: in this thin chromatic fog the hero channels' photons (SpectralMis)
+    // spread the beams' flux more than spectral tracking's did (standard errors at 16 passes 0.00187,
+    // 0.00117, 0.00081 against 0.00122, 0.00080, 0.00078).
     SceneDesc d = mediaOnlyScene();
     addFloor(d);
     RenderSettings pt = smallSettings(RenderSettings::Integrator::PathTracer, 64, 0);
-    RenderSettings beams = smallSettings(RenderSettings::Integrator::PhotonMap, 16, 0);
+    RenderSettings beams = smallSettings(RenderSettings::Integrator::PhotonMap, 32, 0);
     beams.photonsPerPass = 4000;
     beams.photonBeams = true;
     for (int c = 0; c < 3; ++c) {

@@ -168,7 +168,7 @@ TEST(Sampling, PathChoicesAreStratifiedOverAPixelsSamplesAndTakeNoDimension) {
     // pixel each of the 3 choices comes within 2 of 2^m / 3 times (a scrambled van der Corput point
     // per sample, one in each interval of width 2^-m: a choice's third of [0, 1) holds all of the
     // intervals it covers and at most the two it cuts), where independent draws miss that by about
-    // 11 at m = 9; and the draw takes none of the stratified dimensions.
+    // 11 at m = 9; and the draw takes none of the stratified dimensions (nor, unstratified, any draw).
     for (uint64_t key : {3ull, 0xfeedull, 12345ull})
         for (int m : {3, 6, 9}) {
             int count[3] = {0, 0, 0}, pcg[3] = {0, 0, 0};
@@ -194,6 +194,10 @@ TEST(Sampling, PathChoicesAreStratifiedOverAPixelsSamplesAndTakeNoDimension) {
         b.stratify(i, 77, 64);
         a.pathChoice(3);
         EXPECT_EQ(a.uniform(), b.uniform()) << i;
+        // Unstratified (photons): a hash of the state, which stays as it was.
+        Rng c(7, i), d(7, i);
+        c.pathChoice(3);
+        EXPECT_EQ(c.uniform(), d.uniform()) << i;
     }
 }
 
