@@ -10,8 +10,10 @@
 //     L += flux sigma_s(x_s) p(cos) / (2 r sin(theta)) T_camera(t),
 // the 1D box kernel 1/(2r) across both lines (PPB eq. 4, beam-beam with the blur along the common
 // perpendicular). Short beams end where the flight ended, so the probability that a beam covers a
-// point stands for the beam's transmittance (PPB sec. 4.2); spectral tracking's null-collision
-// weights make that unbiased per channel in chromatic media (each weight change starts a new beam).
+// point stands for the beam's transmittance (PPB sec. 4.2); in chromatic media the spectral MIS
+// weights of null collisions under the channels' largest majorant (photonMapper.cpp: flights that
+// leave beams keep that majorant) make that unbiased per channel (each weight change starts a new
+// beam).
 // The radius shrinks as r_{i+1} = r_i (i + alpha)/(i + 1) (PPB eq. 21: a 1D kernel, not r^2).
 //
 // Thin media are where beams pay: a point photon informs only camera rays passing within r of its

@@ -6,6 +6,7 @@ sampling and time limit (off), spp, seed, --dims (stratifiedDims) and --set over
 
     python tools/bench/per_sample_variance.py homogeneous_cube,surfaces_only --spp 64 --seeds 16
     python tools/bench/per_sample_variance.py atmosphere_sunset --spp 16 --seeds 8 --aovs   # and per AOV
+    python tools/bench/per_sample_variance.py subsurface_bunny --spp 16 --seeds 8 --channels  # and per channel
     python tools/bench/per_sample_variance.py subsurface_bunny --integrator Combined --set photons_per_pass=16000
 
 Compare two builds side by side by running it once with each on PYTHONPATH (a copy of another
@@ -53,6 +54,7 @@ def per_sample_variance(name, spp, seeds, dims, width=80, height=60, overrides=(
     seconds = (time.perf_counter() - t0) / (seeds * spp)
     images = np.array(images)
     per_aov = {a: np.array(v).var(axis=0, ddof=1).mean() * spp for a, v in aovs.items()}
+    per_aov["channels"] = images.var(axis=0, ddof=1).mean(axis=(0, 1)) * spp  # red, green, blue
     return images.var(axis=0, ddof=1).mean() * spp, images.mean(), seconds, cpu / (seeds * spp), per_aov
 
 
@@ -66,15 +68,18 @@ def main():
                     help="override a RenderSettings field (snake_case, e.g. roulette_depth=1000); repeatable")
     ap.add_argument("--integrator", default="PathTracer", choices=["PathTracer", "PhotonMap", "Combined", "Auto"])
     ap.add_argument("--aovs", action="store_true", help="also the per-sample variance of each AOV")
+    ap.add_argument("--channels", action="store_true", help="also the per-sample variance of each colour channel")
     a = ap.parse_args()
     extra = "".join(" %s |" % k for k in AOVS) if a.aovs else ""
+    extra += " red | green | blue |" if a.channels else ""
     print("| scene | per-sample variance | mean | ms per pass (80x60, all cores) | CPU ms per pass |%s\n|---|---|---|---|---|%s"
-          % (extra, "---|" * len(AOVS) if a.aovs else ""))
+          % (extra, "---|" * (len(AOVS) * a.aovs + 3 * a.channels)))
     for name in a.scenes.split(","):
         overrides = [kv.split("=", 1) for kv in a.set]
         v, m, sec, cpu, per_aov = per_sample_variance(name, a.spp, a.seeds, a.dims, overrides=overrides,
                                                       integrator=a.integrator)
         cells = "".join(" %.5f |" % per_aov[k] for k in AOVS) if a.aovs else ""
+        cells += "".join(" %.5f |" % c for c in per_aov["channels"]) if a.channels else ""
         print("| %s | %.5f | %.5f | %.2f | %.2f |%s" % (name, v, m, sec * 1e3, cpu * 1e3, cells), flush=True)
 
 
