@@ -184,7 +184,7 @@ public:
         }
         return 0;
     }
-    /// One of n choices for a whole path (the path tracer's hero channel), drawn outside every
+    /// One of n choices for a whole path (a camera path's or photon's hero channel), drawn outside every
     /// dimension the draws above use. Under stratify() it is an Owen-scrambled van der Corput point
     /// of the sample index (its own scramble), so a pixel's passes take the n choices in near-equal
     /// numbers; otherwise a hash of PCG32's state, which it leaves as it was.
