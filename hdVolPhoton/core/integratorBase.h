@@ -48,7 +48,6 @@ inline double rouletteSurvival(double betaMax, int depth) {
     return depth >= DeepRouletteDepth ? std::min(p, DeepRouletteSurvival) : p;
 }
 
-/// Outcome of scattering at a surface for a path arriving along direction d.
 /// Spectral MIS over a path (Miller, Georgiev and Jarosz 2019, "A null-scattering path integral
 /// formulation of light transport", sec. 5.2; pbrt-v4's VolPathIntegrator keeps the same ratios as
 /// r_u), for camera paths (pathTracer.cpp) and photons (photonMapper.cpp): a path's flights are its
@@ -108,6 +107,7 @@ struct SpectralMis {
     }
 };
 
+/// Outcome of scattering at a surface for a path arriving along direction d.
 struct SurfaceScatter {
     enum class Type { Absorbed, Diffuse, Specular, Pass };
     Type type = Type::Absorbed;

@@ -860,12 +860,12 @@ private:
                 // spectral weight, each ending where the flight or the weight changed (photonBeams.h).
                 const bool beams = events >= 1 && storedIn(stack) && beamsIn(stack.innermost());
                 double pieceStart = 0, sigmaMaj = 0;  // the majorant where the last piece ended
-                auto addBeam = [&](double t1) {
+                auto addBeam = [&](double t1, const Spectrum& carried) {
                     int region = stack.innermost();
                     // The mean-free-path cap, as for points (radiusCap), from the majorant at the
                     // piece's end: beams in an opaque layer's skin are short, and so are their kernels.
                     float cap = region < 0 ? radiusCap(sigmaMaj) : std::numeric_limits<float>::infinity();
-                    if (beams) addBeamPiece(ray, pieceStart, t1, flux, media, region, cap, &out->beams);
+                    if (beams) addBeamPiece(ray, pieceStart, t1, carried, media, region, cap, &out->beams);
                     pieceStart = t1;
                 };
                 // The hero channel's flight (SpectralMis): absorption, scattering and null collisions
@@ -885,12 +885,12 @@ private:
                     const double maj = flight.chromatic ? flight.sigmaMaj[h] : m.sigmaMaj;
                     const Spectrum sigma_t = m.mp.sigma_t();
                     const double x = rng.uniform() * maj;
-                    if (x < m.mp.sigma_a[h]) { absorbed = true; addBeam(m.t); return false; }
+                    if (x < m.mp.sigma_a[h]) { absorbed = true; addBeam(m.t, flux); return false; }
                     const Spectrum& sigma_s = m.mp.sigma_s;
                     const bool grey = !flight.chromatic && sigma_t[0] == sigma_t[1] && sigma_t[1] == sigma_t[2] &&
                                       sigma_s[0] == sigma_s[1] && sigma_s[1] == sigma_s[2];
                     if (x < sigma_t[h]) {
-                        addBeam(m.t);
+                        addBeam(m.t, flux);
                         // grey: every channel makes the same choice, and flux takes 1 / sigma_s
                         if (grey ? sigma_s.isBlack() : !mis.collide(m, flight, sigma_t, &sigma_s, flux)) {
                             absorbed = true;
@@ -903,18 +903,13 @@ private:
                     }
                     if (grey) return true;  // a null collision of the same weight in every channel
                     const Spectrum before = flux;
-                    if (!mis.collide(m, flight, sigma_t, nullptr, flux)) { absorbed = true; addBeam(m.t); return false; }
-                    if (beams && (flux - before).maxValue() + (before - flux).maxValue() > 1e-6 * before.maxValue()) {
-                        // The weight changed: the piece so far carries the flux before it.
-                        Spectrum after = flux;
-                        flux = before;
-                        addBeam(m.t);
-                        flux = after;
-                    }
+                    if (!mis.collide(m, flight, sigma_t, nullptr, flux)) { absorbed = true; addBeam(m.t, flux); return false; }
+                    // The weight changed: the piece so far carries the flux before it.
+                    if (beams && (flux - before).maxValue() + (before - flux).maxValue() > 1e-6 * before.maxValue()) addBeam(m.t, before);
                     return true;
                 }, beams ? nullptr : &flight);
+                if (end == FlightEnd::Escaped) addBeam(tEnd, flux);  // (a beam's flight has no escape weight)
                 absorbed |= end == FlightEnd::Truncated || (end == FlightEnd::Escaped && !mis.escape(flight.depth, flux));
-                if (end == FlightEnd::Escaped) addBeam(tEnd);
             }
             if (absorbed) return;
             if (scattered) {
