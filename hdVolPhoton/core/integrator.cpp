@@ -20,13 +20,19 @@ Integrator::Integrator(const Scene& scene, const RenderSettings& settings) : sce
     std::vector<double> power;
     for (const LightPtr& l : scene.lights()) power.push_back(l->power(scene.radius()).average());
     if (!power.empty()) lightDist_ = Distribution1D(power);
+    // Medium vertices: constant domes count at MediumDomePickScale of their power (integratorBase.h).
+    std::vector<double> mediumPower = power;
+    for (size_t i = 0; i < mediumPower.size(); ++i)
+        if (mediumSamplesDomeByPhase(static_cast<int>(i))) mediumPower[i] *= MediumDomePickScale;
+    if (!mediumPower.empty()) mediumLightDist_ = Distribution1D(mediumPower);
     cameraStack_ = scene.stackAt(Camera(scene.desc().camera, 1, 1).position());
 }
 
 DirectSample Integrator::sampleDirect(const Vec3& p, Rng& rng, const PhaseAt* phase) const {
     DirectSample d;
-    if (!lightDist_.size()) return d;
-    size_t i = lightDist_.sampleDiscrete(rng.uniform(), &d.pickProb);
+    const Distribution1D& dist = phase ? mediumLightDist_ : lightDist_;
+    if (!dist.size()) return d;
+    size_t i = dist.sampleDiscrete(rng.uniform(), &d.pickProb);
     auto [u1, u2] = rng.uniform2();
     d.light = static_cast<int>(i);
     const Light& light = *scene_.lights()[i];

@@ -304,7 +304,7 @@ public:
             // Reached a light, a surface, or escaped.
             if (ahead.reachesLight()) {
                 auto addLight = [&](int light, const Spectrum& Le, double lightPdf) {
-                    double pick = prevSurface ? surfaceLightPickProb(light) : lightPickProb(light);
+                    double pick = prevSurface ? surfaceLightPickProb(light) : mediumLightPickProb(light);
                     // A constant dome after a medium vertex: that vertex sampled it by its phase
                     // function, whose density in this direction is prevPdf (mediumSamplesDomeByPhase).
                     if (!prevSurface && mediumSamplesDomeByPhase(light)) lightPdf = prevPdf;

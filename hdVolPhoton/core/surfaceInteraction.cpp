@@ -109,7 +109,7 @@ Spectrum Integrator::surfaceEmission(const Ray& ray, const SurfaceHit& hit) cons
 double Integrator::emitterDensity(const Vec3& from, const SurfaceHit& hit, bool fromSurface) const {
     int light = scene_.instanceLight(hit.instance);
     if (light < 0) return 0.0;
-    double pick = fromSurface ? surfaceLightPickProb(light) : lightPickProb(light);
+    double pick = fromSurface ? surfaceLightPickProb(light) : mediumLightPickProb(light);
     return pick * scene_.lights()[light]->pdfAt(from, hit.p, hit.ng);
 }
 
