@@ -467,25 +467,26 @@ MediumProperties GridMedium::properties(const Vec3& p) const {
     const Vec3 pi = m.fields[DensityField].worldToIndex.point(p);
     if (!m.support.contains(pi)) return mp;
     Impl::AccessorCache& cache = m.accessors();
-    const double d = std::min(sampleTrilinear(*cache.acc[DensityField], pi), m.densityCap);
+    const double density = sampleTrilinear(*cache.acc[DensityField], pi);
+    const double d = std::min(density, m.densityCap);
     if (!(d > 0)) return mp;
+    // Another field's value at p; a field that is the density grid itself is not looked up again.
+    auto field = [&](int f) {
+        return m.fields[f].grid == m.fields[DensityField].grid ? density
+                                                                : sampleTrilinear(*cache.acc[f], m.fields[f].worldToIndex.point(p));
+    };
 
     const Spectrum sigma_t = m.sigmaTPerDensity * d;
     Spectrum albedo = m.albedo;
-    if (m.fields[AlbedoField].bound()) {
-        double a = sampleTrilinear(*cache.acc[AlbedoField], m.fields[AlbedoField].worldToIndex.point(p));
-        albedo *= std::clamp(a, 0.0, 1.0);
-    }
+    if (m.fields[AlbedoField].bound()) albedo *= std::clamp(field(AlbedoField), 0.0, 1.0);
     const Spectrum sigma_s = sigma_t * albedo;
     mp.sigma_a = sigma_t - sigma_s;
     mp.addLobe(m.desc.phase.get(), sigma_s);
 
     Spectrum e = m.emission;
-    if (m.fields[EmissionField].bound() && !e.isBlack())
-        e *= sampleTrilinear(*cache.acc[EmissionField], m.fields[EmissionField].worldToIndex.point(p));
+    if (m.fields[EmissionField].bound() && !e.isBlack()) e *= field(EmissionField);
     if (m.fields[TemperatureField].bound() && m.desc.emissionScale > 0 && !mp.sigma_a.isBlack()) {
-        double T = m.desc.temperatureScale *
-                   sampleTrilinear(*cache.acc[TemperatureField], m.fields[TemperatureField].worldToIndex.point(p));
+        double T = m.desc.temperatureScale * field(TemperatureField);
         if (T > 0) e += mp.sigma_a * blackbodyRadiance(T) * m.desc.emissionScale;
     }
     mp.emission = e;

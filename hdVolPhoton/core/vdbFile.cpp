@@ -210,7 +210,13 @@ std::vector<std::shared_ptr<const openvdb::GridBase>> readVdbFloatGrids(const st
                                     "), but a float grid (FloatGrid) is required");
             return g;
         };
-        for (const VdbGridRequest& request : requests) grids.push_back(readFloatGrid(request.name, request.role));
+        for (size_t i = 0; i < requests.size(); ++i) {
+            // A grid named twice (the density grid also as the emission: emission proportional to
+            // density) is read once and shared: half the memory, and GridMedium looks it up once.
+            size_t same = 0;
+            while (same < i && (requests[same].name.empty() || requests[same].name != requests[i].name)) ++same;
+            grids.push_back(same < i ? grids[same] : readFloatGrid(requests[i].name, requests[i].role));
+        }
         file.close();
     } catch (const GridLoadError&) {
         throw;

@@ -35,7 +35,8 @@ struct VdbGridRequest {
 };
 
 /// Opens `path`, checks its structure and reads the requested grids, each of which must be a
-/// FloatGrid; the result has one entry per request, in order (null where the name is ""). Nothing is
+/// FloatGrid; the result has one entry per request, in order (null where the name is ""; requests
+/// of the same name share one grid). Nothing is
 /// loaded lazily: the grids never touch the file again. Throws std::runtime_error naming the file and
 /// grid on a corrupt or truncated file, a name not in the file (the message lists the grids that are
 /// there with their types), a grid that is not a FloatGrid (naming its type), or one with more than

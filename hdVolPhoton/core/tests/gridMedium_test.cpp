@@ -22,6 +22,7 @@
 #include "core/proceduralCloud.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/vdbFile.h"
 
 using namespace volphoton;
 using openvdb::Coord;
@@ -652,6 +653,45 @@ TEST(GridEmission, BlackbodyColourAndTemperatureEmission) {
     EXPECT_NEAR(m.maxAlbedo(), 0.25, 1e-12);
     desc.temperatureGrid.clear();
     EXPECT_FALSE(GridMedium(desc, GridMediumGrids{dens}).isEmissive());
+}
+
+TEST(GridEmission, ADensityGridNamedAsTheEmissionIsReadOnceAndLookedUpOnce) {
+    // Emission proportional to density (field:emission naming the density grid, as benchmark scene
+    // 6 does): the file's grid is read once and shared (readVdbFloatGrids), and the medium's
+    // coefficients are those with a separate grid of twice the values as the emission, but for the
+    // factor 2 (exact in floating point), point for point.
+    std::string path = tempPath("emission_is_density.vdb");
+    FloatGrid::Ptr smoke = FloatGrid::create(0.0f);
+    smoke->setName("smoke");
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j)
+            for (int k = 0; k < 8; ++k) smoke->tree().setValue(Coord(i, j, k), 0.1f + 0.3f * i + 0.05f * j * k);
+    FloatGrid::Ptr glow = smoke->deepCopy();
+    glow->setName("glow");
+    for (auto v = glow->tree().beginValueOn(); v; ++v) v.setValue(2 * *v);
+    writeGrids(path, {smoke, glow});
+    auto grids = readVdbFloatGrids(path, {{"smoke", "density"}, {"", "temperature"}, {"smoke", "emission"}, {"glow", "albedo"}}, 0);
+    EXPECT_EQ(grids[0], grids[2]);
+    EXPECT_NE(grids[0], grids[3]);
+    GridMediumDesc desc;
+    desc.filePath = path;
+    desc.densityGrid = "smoke";
+    desc.emission = Spectrum(3.0, 0.9, 0.2);
+    desc.emissionGrid = "smoke";
+    auto shared = loadGridMedium(desc);
+    desc.emissionGrid = "glow";
+    auto separate = loadGridMedium(desc);
+    Rng rng(7);
+    for (int n = 0; n < 200; ++n) {
+        Vec3 p(-1 + 10 * rng.uniform(), -1 + 10 * rng.uniform(), -1 + 10 * rng.uniform());
+        MediumProperties a = shared->properties(p), b = separate->properties(p);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(2 * a.emission[c], b.emission[c]) << "at " << p.x << " " << p.y << " " << p.z;
+            EXPECT_EQ(a.sigma_t()[c], b.sigma_t()[c]);
+        }
+    }
+    EXPECT_GT(shared->properties(Vec3(4, 4, 4)).emission[0], 0.0);
+    std::remove(path.c_str());
 }
 
 // ---- concurrency -------------------------------------------------------------------------------
