@@ -435,7 +435,6 @@ def _subsurface_ball() -> BenchScene:
         lights=[SphereLight(position=(-1.0, 2.5, -4.0), radius=1.0, radiance=(12.0, 11.4, 10.5)),
                 Dome((0.1, 0.1, 0.12))],
         max_depth=1000,
-        photon_settings={"photons_per_pass": 20000},
         notes="a radius-1 ball (5120 triangles) of a chromatic medium, sigma_t = (6, 8, 10), albedo (0.99, 0.97, "
               "0.95), isotropic, behind a smooth n = 1.3 surface; a spherical area light behind the ball and a "
               "faint sky.",
@@ -463,7 +462,6 @@ def _subsurface_bunny() -> BenchScene:
         lights=[SphereLight(position=(1.0, 7.0, -8.0), radius=2.0, radiance=(14.0, 13.0, 11.5)),
                 Dome((0.15, 0.15, 0.15))],
         max_depth=100000,
-        photon_settings={"photons_per_pass": 4000},
         meters_per_unit=0.01,
         notes="the 3.4 cm figurine of testenv/subsurface_bunny.usda (4666 triangles) in Jensen et al. 2001's marble "
               "(sigma_t 22-30 per cm, albedo 0.998-0.999, n = 1.3), a spherical area light from behind and a grey sky; paths "
