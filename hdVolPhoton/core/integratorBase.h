@@ -77,7 +77,17 @@ struct SpectralMis {
     /// *real / sigma_maj (sigma_t where it always scatters, sigma_s where absorption ends paths; its
     /// kernel, sigma_s, is the caller's), or a null one (real == nullptr). Densities and
     /// contributions are both over e^-(majorant depth), relative to the smallest depth, which cancels.
+    /// Where the flight's majorant is one for all channels and sigma_t (and *real) are grey, every
+    /// channel makes the same choice with the same density: r stays, a real collision divides the
+    /// weight by its density and a null one leaves it.
     bool collide(const MediumEvent& e, const SpectralFlight& sf, const Spectrum& sigma_t, const Spectrum* real, Spectrum& weight) {
+        auto grey = [](const Spectrum& x) { return x[0] == x[1] && x[1] == x[2]; };
+        if (!sf.chromatic && grey(sigma_t) && (!real || grey(*real))) {
+            const double density = real ? std::min((*real)[0], e.sigmaMaj) : e.sigmaMaj - std::min(sigma_t[0], e.sigmaMaj);
+            if (!(density > 0)) return false;
+            if (real) weight *= 1 / density;
+            return true;
+        }
         Spectrum f, d;
         const double m = sf.chromatic ? sf.depth.minValue() : 0.0;
         for (int k = 0; k < 3; ++k) {

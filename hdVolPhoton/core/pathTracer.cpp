@@ -363,19 +363,14 @@ private:
     /// depth since the previous event), with beta and mis.r updated: a real collision scatters with
     /// the albedo as a weight (sigma_s in the phase kernel) instead of ending the path with probability
     /// sigma_a / sigma_t; Russian roulette ends low-throughput paths later. Real with probability
-    /// sigma_t / sigma_maj of the hero; in grey media (one majorant, one sigma_t) every channel makes
-    /// the same choice with the same density, and r is unchanged.
+    /// sigma_t / sigma_maj of the hero (SpectralMis::collide weighs every channel; in grey media
+    /// without further work).
     static Collision spectralTracking(const MediumEvent& e, const SpectralFlight& sf, Spectrum& beta, SpectralMis& mis, Rng& rng) {
         const Spectrum sigma_t = e.mp.sigma_t();
         const int h = mis.hero;
         const double majH = sf.chromatic ? sf.sigmaMaj[h] : e.sigmaMaj;
-        const double pc = std::min(1.0, sigma_t[h] / majH);
-        const bool real = rng.uniform() < pc;
+        const bool real = rng.uniform() * majH < sigma_t[h];
         if (real && e.mp.sigma_s.isBlack()) return Collision::Absorb;
-        if (!sf.chromatic && sigma_t[0] == sigma_t[1] && sigma_t[1] == sigma_t[2]) {
-            if (real) beta *= 1 / (majH * pc);
-            return real ? Collision::Scatter : Collision::Null;
-        }
         if (!mis.collide(e, sf, sigma_t, real ? &sigma_t : nullptr, beta)) return Collision::Absorb;
         return real ? Collision::Scatter : Collision::Null;
     }

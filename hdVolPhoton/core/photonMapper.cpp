@@ -887,21 +887,16 @@ private:
                     const double x = rng.uniform() * maj;
                     if (x < m.mp.sigma_a[h]) { absorbed = true; addBeam(m.t, flux); return false; }
                     const Spectrum& sigma_s = m.mp.sigma_s;
-                    const bool grey = !flight.chromatic && sigma_t[0] == sigma_t[1] && sigma_t[1] == sigma_t[2] &&
-                                      sigma_s[0] == sigma_s[1] && sigma_s[1] == sigma_s[2];
                     if (x < sigma_t[h]) {
                         addBeam(m.t, flux);
-                        // grey: every channel makes the same choice, and flux takes 1 / sigma_s
-                        if (grey ? sigma_s.isBlack() : !mis.collide(m, flight, sigma_t, &sigma_s, flux)) {
+                        if (!mis.collide(m, flight, sigma_t, &sigma_s, flux)) {
                             absorbed = true;
                             return false;
                         }
-                        if (grey) flux *= 1 / sigma_s[h];
                         ev = m;
                         scattered = true;
                         return false;
                     }
-                    if (grey) return true;  // a null collision of the same weight in every channel
                     const Spectrum before = flux;
                     if (!mis.collide(m, flight, sigma_t, nullptr, flux)) { absorbed = true; addBeam(m.t, flux); return false; }
                     // The weight changed: the piece so far carries the flux before it.
