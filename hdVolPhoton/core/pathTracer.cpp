@@ -510,12 +510,14 @@ private:
         return D / ((thB - thA) * (D * D + (t - delta) * (t - delta)));
     }
 
-    /// The equiangular strategy: one point light picked by power, one distance along the segment,
-    /// camera-side transmittance by ratio tracking, MIS weight against distance sampling.
+    /// The equiangular strategy: one point light picked as at a collision (mediumLightPickProb: a
+    /// sphere light's direction weights against the collisions' and the continuation's take that
+    /// pick), one distance along the segment, camera-side transmittance by ratio tracking, MIS weight
+    /// against distance sampling.
     Spectrum equiangularPointLight(const Medium& media, const Ray& ray, const Support& support, const MediumStack& stack,
                                    const Spectrum& beta, Rng& rng) const {
         double pick;
-        size_t li = lightDist_.sampleDiscrete(rng.uniform(), &pick);
+        size_t li = mediumLightDist_.sampleDiscrete(rng.uniform(), &pick);
         double u = rng.uniform();
         auto [u1, u2] = rng.uniform2();
         if (!isPointLight(static_cast<int>(li))) return {};
