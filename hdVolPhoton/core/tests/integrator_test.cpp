@@ -302,6 +302,18 @@ TEST(IntegratorDome, AConstantDomeIsSampledByThePhaseAtMediumVertices) {
     EXPECT_LT(constant.pixelVariance, 0.8 * textured.pixelVariance);
 }
 
+/// Scene 1's cube (sigma_t 2, albedo 0.8, HG 0.5) seen from (0.2, 0.1, 3), under the dome of
+/// radiance 1 of furnaceScene or not, with `other` light (if any) added.
+std::function<SceneDesc()> domeLitCubeWith(bool dome, LightPtr other) {
+    return [dome, other] {
+        auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeHenyeyGreensteinPhase(0.5));
+        SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}), Vec3(0.2, 0.1, 3));
+        if (!dome) d.lights.clear();
+        if (other) d.lights.push_back(other);
+        return d;
+    };
+}
+
 TEST(IntegratorDome, MediumVerticesLeaveMostOfADomeToTheContinuation) {
     // Beside a sun, a medium vertex picks a constant dome for its next-event estimate at
     // MediumDomePickScale of the dome's power (Integrator::mediumLightPickProb): the continuation,
@@ -312,13 +324,7 @@ TEST(IntegratorDome, MediumVerticesLeaveMostOfADomeToTheContinuation) {
     // by its power pick measured -10%), and its per-pixel variance at most 1.1x the sum of the
     // separate renders' (0.79x measured; picks by power 1.44x).
     auto cube = [](bool dome, bool sun) {
-        return [dome, sun] {
-            auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeHenyeyGreensteinPhase(0.5));
-            SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}), Vec3(0.2, 0.1, 3));
-            if (!dome) d.lights.clear();
-            if (sun) d.lights.push_back(makeDistantLight(normalize(Vec3(0.3, -0.8, 0.5)), 0.0, Spectrum(3.0)));
-            return d;
-        };
+        return domeLitCubeWith(dome, sun ? makeDistantLight(normalize(Vec3(0.3, -0.8, 0.5)), 0.0, Spectrum(3.0)) : nullptr);
     };
     RenderSettings s = smallSettings(RenderSettings::Integrator::PathTracer, 16, 0);
     SeedStats both = seedStats(renderSeeds(cube(true, true), s));
@@ -338,13 +344,7 @@ TEST(IntegratorDome, ADomeBesideASphereLightInAMediumAddsUp) {
     // light's renders are noisy); the equiangular sample picking by unscaled power measured -1.2%,
     // -7 standard errors.
     auto cube = [](bool dome, bool sphere) {
-        return [dome, sphere] {
-            auto c = MediumCoefficients::fromAlbedo(2.0, Spectrum(1.0), Spectrum(0.8), Spectrum(0.0), makeHenyeyGreensteinPhase(0.5));
-            SceneDesc d = furnaceScene(std::make_shared<HomogeneousMedium>(c, Bounds3{Vec3(-1, -1, -1), Vec3(1, 1, 1)}), Vec3(0.2, 0.1, 3));
-            if (!dome) d.lights.clear();
-            if (sphere) d.lights.push_back(makeSphereLight(Vec3(0.0, 0.3, 0.6), 0.1, Spectrum(20.0)));
-            return d;
-        };
+        return domeLitCubeWith(dome, sphere ? makeSphereLight(Vec3(0.0, 0.3, 0.6), 0.1, Spectrum(20.0)) : nullptr);
     };
     RenderSettings s = smallSettings(RenderSettings::Integrator::PathTracer, 256, 0);
     SeedStats both = seedStats(renderSeeds(cube(true, true), s));
