@@ -30,3 +30,24 @@ def test_mean_check_sigma_counts_pixels_not_channels():
         err = float(np.sqrt(np.mean((img - ref) ** 2)))
         zs.append(run.mean_check(img, ref, err)["z"])
     assert abs(np.std(zs) - 1.0) < 0.15, np.std(zs)
+
+
+def test_mean_check_sigma_sees_noise_that_pixels_share():
+    # A photon map's noise is shared by every pixel of its pass. Renders of 16 passes whose pixels
+    # carry each pass's common offset (sigma 0.05) beside independent noise (sigma 0.1): over 400
+    # renders of an exact reference z must spread with standard deviation 1 (tolerance 0.15, 4
+    # standard errors of the spread as above) when the passes' image means are given; from the pixels
+    # alone it spreads far wider (the common offset's sigma / sqrt(16) against 0.1 / sqrt(16 x 1200)).
+    run = _run_module()
+    rng = np.random.default_rng(7)
+    ref = np.full((30, 40, 3), 0.5)
+    with_passes, pixels_only = [], []
+    for _ in range(400):
+        passes = ref + rng.normal(0.0, 0.05, (16, 1, 1, 1)) + rng.normal(0.0, 0.1, (16, 30, 40, 1))
+        img = passes.mean(axis=0)
+        err = float(np.sqrt(np.mean((img - ref) ** 2)))
+        pass_means = passes.mean(axis=(1, 2, 3))
+        with_passes.append(run.mean_check(img, ref, err, pass_means)["z"])
+        pixels_only.append(run.mean_check(img, ref, err)["z"])
+    assert abs(np.std(with_passes) - 1.0) < 0.15, np.std(with_passes)
+    assert np.std(pixels_only) > 5, np.std(pixels_only)

@@ -79,12 +79,18 @@ def cmd_render(a) -> int:
     setup = time.perf_counter() - t0
     elapsed, passes = 0.0, 0
     times, spps, images = [], [], []
+    # Each pass's own image mean (from the cumulative film's, untimed): the spread of these gives the
+    # final image mean's noise where pixels share randomness (a pass's photon map), run.mean_check.
+    pass_means, cumulative = [], 0.0
     bi = 0
     while bi < len(budgets) and passes < a.max_passes:
         t = time.perf_counter()
         r.render_pass()
         elapsed += time.perf_counter() - t
         passes += 1
+        m = float(np.mean(r.film.beauty))
+        pass_means.append(passes * m - (passes - 1) * cumulative)
+        cumulative = m
         if elapsed >= budgets[bi]:
             times.append(elapsed)
             spps.append(passes)
@@ -93,6 +99,7 @@ def cmd_render(a) -> int:
                 bi += 1
     stats = r.stats
     np.savez_compressed(a.out, times=np.array(times), spp=np.array(spps), images=np.array(images),
+                        pass_means=np.array(pass_means),
                         meta=json.dumps({"build_seconds": build_s, "renderer_setup_seconds": setup,
                                          "settings": s.to_dict(), "stats": _jsonable(stats),
                                          "warnings": warnings[:20], "core_no_volumes": bool(core.NO_VOLUMES)}))

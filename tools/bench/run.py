@@ -145,17 +145,28 @@ def cross_check(ref_a, ref_b):
             "rmse_between": rmse(ma, mb), "expected_rmse_from_noise": float(np.sqrt(np.mean(var)))}
 
 
-def mean_check(img, ref, err):
-    """A single converged-ish peer image against our reference: difference of the image means and
-    its approximate standard error (pixels independent: noise RMSE / sqrt(pixel count)). A pixel's
+def mean_check(img, ref, err, pass_means=None):
+    """A single converged-ish image against our reference: difference of the image means and its
+    standard error. From the pixels (pixels independent: noise RMSE / sqrt(pixel count)); a pixel's
     channels share its paths, so they count as one sample, not three: in grey scenes they move
     together, and counting them apart understated sigma by sqrt(3) (seeds' image means of 24 renders
-    of benchmark scene 2 spread 1.13x sigma computed per pixel, 1.96x sigma computed per channel)."""
+    of benchmark scene 2 spread 1.13x sigma computed per pixel, 1.96x sigma computed per channel).
+    Where the render's passes' own image means are known (ours.py render, `pass_means`, at least 8
+    passes) sigma is the larger of that and their spread / sqrt(passes): a photon map's noise is shared
+    by every pixel of its pass, which the pixel count does not see (benchmark scene 10's photon map at
+    4 s, 25 passes: sigma 0.00044 from the pixels, 0.00082 from the passes, so z -3.3 became -1.8;
+    converged, the photon map and the path tracer agree, tools/bench/README.md)."""
     d = float(np.mean(img) - np.mean(ref))
     a = np.asarray(img)
     n = a.shape[0] * a.shape[1] if a.ndim == 3 else a.size
-    sigma = err / math.sqrt(n)
+    sigma_pixels = err / math.sqrt(n)
+    sigma_passes = float("nan")
+    if pass_means is not None and len(pass_means) >= 8:
+        pm = np.asarray(pass_means, np.float64)
+        sigma_passes = float(pm.std(ddof=1) / math.sqrt(len(pm)))
+    sigma = max(sigma_pixels, sigma_passes) if sigma_passes == sigma_passes else sigma_pixels
     return {"difference": d, "sigma": sigma, "z": d / sigma if sigma > 0 else float("nan"),
+            "sigma_pixels": sigma_pixels, "sigma_passes": sigma_passes,
             "relative_difference": d / float(np.mean(ref)) if np.mean(ref) else float("nan")}
 
 
@@ -287,7 +298,9 @@ def bench_scene(run: Run, scene: S.BenchScene, peers: dict) -> dict:
                      for e in errs]
         curve = {"times": d["times"].tolist(), "spp": d["spp"].tolist(), "rmse": errs, "rmse_corrected": corrected,
                  "meta": d["meta"], "peak_rss_mb": rss}
-        curve["mean_check"] = mean_check(d["images"][-1], ref_img, corrected[-1] or errs[-1])
+        # The passes of the last snapshot (a render may run a pass or more past its last budget).
+        pass_means = d["pass_means"][:int(d["spp"][-1])] if "pass_means" in d else None
+        curve["mean_check"] = mean_check(d["images"][-1], ref_img, corrected[-1] or errs[-1], pass_means)
         res["curves"][label] = curve
     return res
 
