@@ -88,7 +88,7 @@ def cmd_render(a) -> int:
         r.render_pass()
         elapsed += time.perf_counter() - t
         passes += 1
-        m = float(np.mean(r.film.beauty))
+        m = float(np.mean(r.film.beauty, dtype=np.float64))  # float32 sums would lose the later passes
         pass_means.append(passes * m - (passes - 1) * cumulative)
         cumulative = m
         if elapsed >= budgets[bi]:
