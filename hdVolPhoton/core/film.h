@@ -18,6 +18,10 @@ struct PathRadiance {
     Spectrum albedo, normal;
     double alpha = 0;          ///< 1 when the first segment met a surface or a medium interaction
     double depth = Infinity;   ///< camera distance to the first surface (infinity if none)
+    /// The photon gathers' half-difference (PhotonEstimate::Along::multipleSplit) with the path's
+    /// weights: its square estimates the photon map's variance of this sample (the Renderer's
+    /// photon-noise measurement). Not on the film.
+    Spectrum photonSplit;
     Spectrum beauty() const { return single + multiple + emission + surface; }
 };
 

@@ -463,6 +463,8 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     auto photonsDone = std::chrono::steady_clock::now();
     Camera camera(scene_->desc().camera, settings_.width, settings_.height);
     std::atomic<bool> cancelled{false};
+    const bool measureNoise = integrator_->measuresPhotonNoise() && photonNoisePasses_ < PhotonNoisePasses;
+    if (measureNoise && photonNoise_.empty()) photonNoise_.resize(active_.size());
     const int tile = 16;
     int tilesX = (settings_.width + tile - 1) / tile, tilesY = (settings_.height + tile - 1) / tile;
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tilesY, 0, tilesX), [&](const tbb::blocked_range2d<int>& r) {
@@ -487,6 +489,13 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                                 // never on the film: dropped, and reported
                                 static std::atomic<int> reported{0};
                                 if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
+                            } else if (measureNoise && !light && L.photonSplit.isFinite()) {
+                                // One sample a pass (light pixels, with several, are left out).
+                                PhotonNoisePixel& m = photonNoise_[static_cast<size_t>(y) * settings_.width + x];
+                                if (m.samples == photonNoisePasses_) {
+                                    m.x[m.samples++] = L.beauty().average();
+                                    m.split2 += L.photonSplit.average() * L.photonSplit.average();
+                                }
                             }
                             film_.add(x, y, L);
                         }
@@ -499,6 +508,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
         for (const LightPixel& p : lightPixels_) stats_.cameraSamples += active_[p.index] ? LightPixelSamples - 1 : 0;
         ++pass_;
         ++stats_.passes;
+        if (measureNoise && ++photonNoisePasses_ == PhotonNoisePasses) measurePhotonNoise();
         updateAdaptive();  // timed with the pass: the time limit counts it
     }
     auto end = std::chrono::steady_clock::now();
@@ -506,11 +516,32 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     stats_.cameraSeconds += std::chrono::duration<double>(end - photonsDone).count();
     stats_.seconds += std::chrono::duration<double>(end - start).count();
     lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
+    // The next pass's photons, where the measurement just raised their count, take that much longer.
+    if (pass_ == PhotonNoisePasses && stats_.photonsPerPassResized > stats_.photonsPerPass && stats_.photonsPerPass > 0)
+        lastPassSeconds_ += std::chrono::duration<double>(photonsDone - start).count() *
+                            (double(stats_.photonsPerPassResized) / stats_.photonsPerPass - 1);
     if (cancelled) {
         stats_.cancelled = true;
         return false;
     }
     return true;
+}
+
+/// The photon map's share of a sample's variance and the whole, over the pixels that took a sample in
+/// every measurement pass (summed in pixel order: the same on any number of threads), to the
+/// integrator, which sizes its later photon passes by them (PhotonMapper, "how many photons").
+void Renderer::measurePhotonNoise() {
+    static_assert(PhotonNoisePasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
+    double photon = 0, whole = 0;
+    int pixels = 0;
+    for (const PhotonNoisePixel& m : photonNoise_) {
+        if (m.samples != PhotonNoisePasses) continue;
+        photon += m.split2 / PhotonNoisePasses;
+        whole += 0.5 * (m.x[1] - m.x[0]) * (m.x[1] - m.x[0]);
+        ++pixels;
+    }
+    photonNoise_ = {};
+    if (pixels > 0) integrator_->photonNoiseMeasured(photon / pixels, whole / pixels, pixels, stats_);
 }
 
 void Renderer::updateAdaptive() {

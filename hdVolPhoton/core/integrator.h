@@ -43,7 +43,10 @@
 // | photonsPerPass      | int    | 0 (auto)   |              | photonMap: photons traced per pass. auto: as many |
 // |                     |        |            |              | as cost one camera pass, tracing and gathers      |
 // |                     |        |            |              | (pilots count work, not time), in [4096, 1e6]     |
-// |                     |        |            |              | (autoPhotonsPerPass), or the count of the maps a  |
+// |                     |        |            |              | (autoPhotonsPerPass); after PhotonNoisePasses (2) |
+// |                     |        |            |              | passes raised, up to 8x, where the photon map's   |
+// |                     |        |            |              | measured noise outweighs its cost (PhotonMapper,  |
+// |                     |        |            |              | "how many photons"); or the counts of the maps a  |
 // |                     |        |            |              | PhotonCache keeps                                 |
 // | initialRadius       | double | 0 (auto)   | scene units  | photonMap: beam radius of pass 0 (auto: 1/100 of  |
 // |                     |        |            |              | the media's diameter, Scene::mediaRadius, else of |
@@ -171,6 +174,11 @@ struct RenderStats {
     double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
     double photonRadius = 0;
     int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic), 0 without photons
+    /// An automatic count's size from pass PhotonNoisePasses on, measured by the first passes (at least
+    /// photonsPerPass; 0: not measured)
+    int photonsPerPassResized = 0;
+    /// The photon map's share of a camera sample's variance in the measurement passes (-1: not measured)
+    double photonVarianceShare = -1;
     /// photonMap: photons whose tracing and gathers cost as much as a camera pass (pilots; 0: not measured)
     double photonWorkRatio = 0;
     /// photonMap pilots: rays and lookups of a camera pass without photons, of tracing a photon, and
@@ -252,6 +260,12 @@ class PhotonCache;
 /// The former fixed 1e5 made a 4 x 4-pixel check 14x slower (vdb_cloud, 64 passes: 3.45 s of photons
 /// against 0.24 s at 4096).
 constexpr int MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
+/// The automatic count is then measured over PhotonNoisePasses passes and raised by at most
+/// MaxPhotonGrowth x where the photon map's noise outweighs its cost (PhotonMapper, "how many photons"),
+/// the camera side's share of a sample's variance taken as at least 1 / CameraShareFloor of it (the
+/// difference of two measured variances, noisy where the photons are nearly all of it).
+constexpr int PhotonNoisePasses = 2, MaxPhotonGrowth = 8;
+constexpr double CameraShareFloor = 64;
 constexpr double PhotonShare = 1.0;
 inline int autoPhotonsPerPass(double balance) {
     if (!(balance > 0)) return MinAutoPhotons;
@@ -320,8 +334,18 @@ private:
     int pass_ = 0;
     /// Adaptive sampling: 1 where the pixel is still sampled (all 1 until samplesPerPixel passes).
     std::vector<uint8_t> active_;
-    double lastPassSeconds_ = 0;
+    double lastPassSeconds_ = 0;  ///< the last pass's seconds: the time the next is expected to take
     bool usesPhotons_ = false;  ///< the photon-map integrator renders (the scene has media)
+    /// The photon-noise measurement passes (Integrator::measuresPhotonNoise), per pixel: the beauty's
+    /// channel average of each pass's sample and the squared photonSplit's, summed. Freed after them.
+    struct PhotonNoisePixel {
+        double x[PhotonNoisePasses] = {};
+        double split2 = 0;
+        int samples = 0;  ///< measurement passes that gave this pixel one usable sample
+    };
+    std::vector<PhotonNoisePixel> photonNoise_;
+    int photonNoisePasses_ = 0;
+    void measurePhotonNoise();
     /// Pixels whose footprint holds the image of a point-like light (Light::equiangularCenter) in a
     /// scene with media, sorted by pixel index: their camera samples take positions from
     /// samplePixelAroundPoint (sampling.h), whose variance stays bounded where the medium's scattered

@@ -219,6 +219,15 @@ public:
     /// thread. The photon map sizes its automatic photon count from it: once without photons, once with
     /// its pilot photons' maps (what a stored photon adds to a camera pass: its gathers).
     virtual void setCameraPilot(std::function<work::Count()> pilot) { (void)pilot; }
+    /// The automatic photon count's measurement (PhotonMapper, "how many photons"): true while this
+    /// pass's camera samples report their photon gathers' half-difference (PathRadiance::photonSplit).
+    virtual bool measuresPhotonNoise() const { return false; }
+    /// After the measurement passes: `photonVariance`, the mean over pixels of the photon map's share
+    /// of a sample's variance (from photonSplit), and `sampleVariance`, a sample's whole variance
+    /// (from the spread of the passes), both of the beauty's channel average.
+    virtual void photonNoiseMeasured(double photonVariance, double sampleVariance, int pixels, RenderStats& stats) {
+        (void)photonVariance; (void)sampleVariance; (void)pixels; (void)stats;
+    }
     /// The denoiser guides of a camera ray (integrator.h, "AOVs"): *albedo and *normal at its first
     /// non-specular vertex (through boundaries and smooth dielectrics); a medium collision is sampled
     /// with the free-flight routine (a real collision accepted with probability average sigma_t /
@@ -370,6 +379,9 @@ public:
         Spectrum multiple;  ///< the gather, per unit camera throughput
         Spectrum T{1.0};    ///< the segment's transmittance (closed form, else marched)
         bool interacted = false;  ///< the segment crossed a medium of nonzero density
+        /// In the photon-noise measurement passes (Integrator::measuresPhotonNoise): the gather's
+        /// photons of one half of the pass's paths minus the other's (Photon::half), else zero.
+        Spectrum multipleSplit;
     };
     /// The gather along local.o + t local.d, t in [0, length], in the media `media` (transmittance
     /// from local.o included), single scattering too where wholeSegment(stack), and the

@@ -188,6 +188,7 @@ public:
                     PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
                     addAlong(out.single, beta * a.single);
                     addAlong(out.multiple, beta * a.multiple);
+                    out.photonSplit += beta * a.multipleSplit;
                     if (firstSegment && (a.interacted || !a.multiple.isBlack())) out.alpha = 1;
                     beta *= a.T;
                     absorbed = beta.isBlack();
@@ -229,7 +230,9 @@ public:
                     if (photonShare > 0) {
                         // The photons' estimate along the whole segment, whatever the flight did:
                         // it and the continuation from a collision (below) estimate the same light.
-                        addAlong(out.multiple, betaSegment * photons_->along(media, local, length, stack, rng).multiple * photonShare);
+                        PhotonEstimate::Along a = photons_->along(media, local, length, stack, rng);
+                        addAlong(out.multiple, betaSegment * a.multiple * photonShare);
+                        out.photonSplit += betaSegment * a.multipleSplit * photonShare;
                     }
                 }
             }

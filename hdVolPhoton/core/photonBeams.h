@@ -34,7 +34,8 @@ struct PhotonBeam {
     float dir[3];  ///< unit propagation direction
     float length;
     float power[3];  ///< flux along the beam (before any event at its end)
-    int region;      ///< innermost medium mesh (-1: outside every mesh), as Photon::region
+    int region : 31;  ///< innermost medium mesh (-1: outside every mesh), as Photon::region
+    unsigned half : 1;  ///< as Photon::half
     /// Kernel radius of this beam: the tracer stores a cap tied to the mean free path where the piece
     /// ended (as Photon::radius); the map lowers it to the pass radius.
     float radius;

@@ -15,6 +15,7 @@ bool PhotonCache::use(uint64_t key) {
     passes_.clear();
     bytes_ = 0;
     photonsPerPass_ = 0;
+    resizedPhotonsPerPass_ = 0;
     key_ = key;
     hasKey_ = true;
     return false;
@@ -46,6 +47,16 @@ void PhotonCache::setPhotonsPerPass(int n) {
     photonsPerPass_ = n;
 }
 
+int PhotonCache::resizedPhotonsPerPass() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return resizedPhotonsPerPass_;
+}
+
+void PhotonCache::setResizedPhotonsPerPass(int n) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    resizedPhotonsPerPass_ = n;
+}
+
 size_t PhotonCache::passes() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return passes_.size();
@@ -61,6 +72,7 @@ void PhotonCache::clear() {
     passes_.clear();
     bytes_ = 0;
     photonsPerPass_ = 0;
+    resizedPhotonsPerPass_ = 0;
     hasKey_ = false;
 }
 

@@ -52,6 +52,10 @@ public:
     /// (RenderSettings::photonsPerPass = 0) follows it, so a resized image keeps its photons.
     int photonsPerPass() const;
     void setPhotonsPerPass(int n);
+    /// An automatic count's size from its measurement on (PhotonMapper, "how many photons"; 0 while
+    /// not measured): a render that follows the cached count follows this too.
+    int resizedPhotonsPerPass() const;
+    void setResizedPhotonsPerPass(int n);
     size_t passes() const;
     size_t bytes() const;
     void clear();
@@ -60,7 +64,7 @@ private:
     mutable std::mutex mutex_;
     uint64_t key_ = 0;
     bool hasKey_ = false;
-    int photonsPerPass_ = 0;
+    int photonsPerPass_ = 0, resizedPhotonsPerPass_ = 0;
     size_t bytes_ = 0;
     std::map<int, std::shared_ptr<const Pass>> passes_;
 };

@@ -24,7 +24,10 @@ struct Photon {
     float p[3];
     float dir[3];  ///< propagation direction before the event
     float power[3];
-    int region;  ///< innermost medium mesh at the photon (-1: outside every mesh)
+    int region : 31;  ///< innermost medium mesh at the photon (-1: outside every mesh)
+    /// Which half of the pass's photon paths it came from (alternate paths): the two halves' gathers
+    /// differ by the photon map's own noise (PhotonMapper, "how many photons").
+    unsigned half : 1;
     /// Kernel radius of this photon. The tracer stores a cap tied to the local mean free path; the map
     /// lowers it to the pass radius. Each disc's kernel integrates to one over its own area, so
     /// per-photon radii keep the estimate's energy (a sample-point kernel estimate; Jarosz et al. 2008

@@ -49,7 +49,7 @@
 namespace volphoton {
 namespace {
 
-constexpr int PhotonBatch = 4096;
+constexpr int PhotonBatch = 1024;
 
 class PhotonMapper final : public Integrator, public PhotonEstimate {
 public:
@@ -160,6 +160,7 @@ public:
 
     bool beginPass(int pass, RenderStats& stats, const CancelCallback& cancel) override {
         if (pass == 0) decidePasses(stats);
+        measuringNoise_ = photonsEnabled_ && measureNoise_ && pass < PhotonNoisePasses;
         if (!photonsEnabled_) return true;
         double r = passRadius(pass), rBeams = passBeamRadius(pass);
         stats.photonRadius = beamsIn(-1) ? rBeams : r;
@@ -177,7 +178,7 @@ public:
         }
         PhotonRecords records;
         PhotonCache::Pass traced;
-        if (!tracePhotons(pass, photonsPerPass_, &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
+        if (!tracePhotons(pass, photonsFor(pass), &records, &traced.traced, nullptr, cancel, &traced.thinned)) return false;
         buildMaps(std::move(records), r, rBeams, &traced);
         stats.photonsTraced += traced.traced;
         stats.photonsThinned += traced.thinned;
@@ -189,6 +190,52 @@ public:
     }
 
     void setCameraPilot(std::function<work::Count()> pilot) override { cameraPilot_ = std::move(pilot); }
+
+    // ---- how many photons ---------------------------------------------------------------------
+    // The automatic count starts where a photon pass costs as much as a camera pass (autoPhotonsPerPass:
+    // the pilots' work ratio, the "balance"). The best count is sqrt(a C / (b c)) = balance x sqrt(r):
+    // the time to a given noise is (a/P + b)(C + cP) with a/P the photon map's share of a sample's
+    // variance and b the camera side's, r = a / (b balance) (integrator.h). The first PhotonNoisePasses
+    // passes measure a/P and a + b on the render's own samples: each pass's photon paths alternate
+    // between two halves (Photon::half), and a camera sample's gathers of one half minus the other's
+    // (PathRadiance::photonSplit) have the variance of its photon estimate, its camera path held fixed
+    // (the halves are independent and each has half the paths: Var(E0 - E1) = Var(E0) + Var(E1) =
+    // Var(E)); the spread of a pixel's two samples gives the whole (Renderer). Only a larger count is
+    // taken (at most MaxPhotonGrowth x): two passes' spread overstates b (a pixel's samples are
+    // stratified over the passes, and stratification lowers later passes' variance, not the first two's),
+    // and an overstated b can only understate the count. (A pilot before the render that measured r
+    // with its own camera samples read it 50x apart over seeds, and its independent samples put the
+    // VDB cloud's b 10x above the render's: it halved the count there and doubled the time to a given
+    // noise; the bench README, "Scenes 8-10 at the automatic photon count", and the 2026-12-07 note.)
+    bool measuresPhotonNoise() const override { return measuringNoise_; }
+
+    void photonNoiseMeasured(double photonVariance, double sampleVariance, int pixels, RenderStats& stats) override {
+        measureNoise_ = measuringNoise_ = false;
+        const double s = photonVariance, v = sampleVariance;
+        stats.photonVarianceShare = v > 0 ? s / v : 0.0;
+        const double balance = stats.photonWorkRatio > 0 ? stats.photonWorkRatio : double(photonsPerPass_);
+        double best = photonsPerPass_;
+        if (s > 0 && v > 0) {
+            const double b = std::max(v - s, v / CameraShareFloor);
+            best = std::sqrt(s * photonsPerPass_ * balance / b);
+        }
+        resizedPhotons_ = static_cast<int>(std::clamp(best, double(photonsPerPass_),
+                                                      std::min(double(MaxPhotonGrowth) * photonsPerPass_, double(MaxAutoPhotons))));
+        resizedPhotons_ = std::max(resizedPhotons_, photonsPerPass_);
+        stats.photonsPerPassResized = resizedPhotons_;
+        if (cache_) cache_->setResizedPhotonsPerPass(resizedPhotons_);
+        char text[200];
+        std::snprintf(text, sizeof text, "photons: %d a pass for %d passes, then %d (the photon map's share of a sample's variance %.2g, "
+                      "measured over %d pixels)", photonsPerPass_, PhotonNoisePasses, resizedPhotons_, stats.photonVarianceShare, pixels);
+        stats.passesRun.push_back(text);
+    }
+
+    /// Photons traced in pass `pass`, and before it.
+    int photonsFor(int pass) const { return pass >= PhotonNoisePasses && resizedPhotons_ > 0 ? resizedPhotons_ : photonsPerPass_; }
+    double photonsBefore(int pass) const {
+        if (pass <= PhotonNoisePasses || resizedPhotons_ <= 0) return double(pass) * photonsPerPass_;
+        return double(PhotonNoisePasses) * photonsPerPass_ + double(pass - PhotonNoisePasses) * resizedPhotons_;
+    }
 
     /// The beam radius of pass `pass` (photonBeams): the 1D kernel's schedule r_{i+1} = r_i (i + alpha)/(i + 1)
     /// (Jarosz et al. 2011, "Progressive photon beams", eq. 21), counted in 1e5 photons as passRadius.
@@ -207,7 +254,7 @@ public:
     /// recurrence above exactly).
     double passRadius(int pass) const {
         constexpr double RadiusReferencePhotons = 1e5;
-        double a = settings_.radiusAlpha, x = double(pass) * photonsPerPass_ / RadiusReferencePhotons;
+        double a = settings_.radiusAlpha, x = photonsBefore(pass) / RadiusReferencePhotons;
         if (!(x > 0) || a >= 1) return radius_;
         return radius_ * std::exp(0.5 * (std::lgamma(x + a) - std::lgamma(a) - std::lgamma(x + 1)));
     }
@@ -222,7 +269,7 @@ public:
     bool wholeSegment(const MediumStack& stack) const override { return openSegments_ || scene_.sealedFromLights(stack); }
     Along along(const MediumAggregate& media, const Ray& local, double length, const MediumStack& stack, Rng& rng) const override {
         SegmentResult r = integrateSegment(media, local, length, stack, rng, openSegments_ ? Parts::Scattered : Parts::Gather);
-        return {r.single, r.multiple, r.T, r.interacted};
+        return {r.single, r.multiple, r.T, r.interacted, r.multipleSplit};
     }
 
     PathRadiance Li(const Ray& cameraRay, double nearClip, double farClip, Rng& rng) const override {
@@ -251,6 +298,7 @@ public:
                     SegmentResult seg = integrateSegment(media, local, length, stack, rng);
                     route(out.single) += beta * seg.single;
                     route(out.multiple) += beta * seg.multiple;
+                    out.photonSplit += beta * seg.multipleSplit;
                     route(out.emission) += beta * seg.emission;
                     if (firstSegment && seg.interacted) out.alpha = 1;
                     Tseg = seg.T;
@@ -303,6 +351,7 @@ public:
 private:
     struct SegmentResult {
         Spectrum single, multiple, emission;
+        Spectrum multipleSplit;  ///< the gather's two halves' difference (measurement passes)
         Spectrum T{1.0};
         bool interacted = false;
     };
@@ -434,10 +483,11 @@ private:
         // Only the media's support gathers (sigma_s is zero elsewhere); a kernel that reaches past an
         // interface is renormalised to its part inside (SurfaceCuts: surfaces and media boxes).
         double b = std::min(length, supportEnd);
+        Spectrum* split = measuringNoise_ ? &r.multipleSplit : nullptr;
         if (beams_ && beamsIn(stack.innermost()))
-            r.multiple = gatherBeams(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, beams_->radius()));
+            r.multiple = gatherBeams(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, beams_->radius()), split);
         else if (map_)
-            r.multiple = gather(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, map_->radius()));
+            r.multiple = gather(media, ray, supportStart, b, tr, stack, SurfaceCuts(scene_, media, ray, supportStart, b, map_->radius()), split);
         return r;
     }
 
@@ -657,8 +707,9 @@ private:
     /// The beam radiance estimate along a camera segment: sum over photons of their flux x sigma_s p
     /// of the media at the photon's point on the ray x T x the disc kernel (Photon: the kernel blurs
     /// the arriving radiance, and the scattering coefficient is the ray's own).
+    /// `split` (measurement passes, measuringNoise_): adds the photons of half 0 minus those of half 1.
     Spectrum gather(const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
-                    const MediumStack& stack, SurfaceCuts cuts) const {
+                    const MediumStack& stack, SurfaceCuts cuts, Spectrum* split) const {
         Spectrum sum;
         int region = stack.innermost();
         map_->query(ray, a, b, [&](const Photon& ph, double t, double) {
@@ -668,7 +719,9 @@ private:
             Spectrum f = media.properties(x).scatterKernel(std::clamp(cosTheta, -1.0, 1.0));
             if (f.isBlack()) return;
             double invArea = 1 / (Pi * double(ph.radius) * ph.radius * cuts.inside(t, ph.radius));
-            sum += Spectrum(ph.power[0], ph.power[1], ph.power[2]) * f * tr.at(t) * invArea;
+            Spectrum c = Spectrum(ph.power[0], ph.power[1], ph.power[2]) * f * tr.at(t) * invArea;
+            sum += c;
+            if (split) *split += ph.half ? -c : c;
         });
         return sum;
     }
@@ -676,7 +729,7 @@ private:
     /// Beam x beam 1D with short beams (photonBeams.h): flux sigma_s p / (2 r sin theta) T_camera, over
     /// the part of the kernel's width on the ray's side of a surface (SurfaceCuts).
     Spectrum gatherBeams(const Medium& media, const Ray& ray, double a, double b, const SegmentTransmittance& tr,
-                         const MediumStack& stack, SurfaceCuts cuts) const {
+                         const MediumStack& stack, SurfaceCuts cuts, Spectrum* split) const {
         Spectrum sum;
         int region = stack.innermost();
         beams_->query(ray, a, b, [&](const BeamHit& h) {
@@ -687,7 +740,9 @@ private:
             // sigma_s p at the ray's point, as for photons (gather).
             Spectrum f = media.properties(ray.at(h.tCamera)).scatterKernel(std::clamp(h.cosTheta, -1.0, 1.0));
             if (f.isBlack()) return;
-            sum += Spectrum(beam.power[0], beam.power[1], beam.power[2]) * f * tr.at(h.tCamera) * (kernel / h.sinTheta);
+            Spectrum c = Spectrum(beam.power[0], beam.power[1], beam.power[2]) * f * tr.at(h.tCamera) * (kernel / h.sinTheta);
+            sum += c;
+            if (split) *split += beam.half ? -c : c;
         });
         return sum;
     }
@@ -742,7 +797,14 @@ private:
                 Rng rng(hashKeys(0x50484f54ULL, settings_.seed, pass, b, energy ? 1 : 0));
                 int n = std::min(PhotonBatch, count - b * PhotonBatch);
                 work::Snapshot before = work::snapshot();
-                for (int i = 0; i < n; ++i) tracePhoton(rng, count, &perBatch[b - g0], perEnergy[b - g0].data());
+                PhotonRecords& out = perBatch[b - g0];
+                for (int i = 0; i < n; ++i) {
+                    const size_t photons0 = out.photons.size(), beams0 = out.beams.size();
+                    tracePhoton(rng, count, &out, perEnergy[b - g0].data());
+                    // Alternate paths make the two halves (Photon::half; batches hold an even count).
+                    for (size_t k = photons0; k < out.photons.size(); ++k) out.photons[k].half = i & 1;
+                    for (size_t k = beams0; k < out.beams.size(); ++k) out.beams[k].half = i & 1;
+                }
                 perWork[b - g0] = work::since(before);
             });
             if (cancelled) return false;
@@ -1115,12 +1177,15 @@ private:
             int cached = cache_->photonsPerPass();
             if (settings_.photonsPerPass == 0 && cached > 0 && cache_->use(photonKey(cached, pilot))) {
                 photonsPerPass_ = cached;
+                resizedPhotons_ = cache_->resizedPhotonsPerPass();  // the same later count, once measured
             } else {
                 cache_->use(photonKey(photonsPerPass_, pilot));
                 cache_->setPhotonsPerPass(photonsPerPass_);
             }
         }
         stats.photonsPerPass = photonsPerPass_;
+        measureNoise_ = settings_.photonsPerPass == 0 && resizedPhotons_ == 0;
+        stats.photonsPerPassResized = resizedPhotons_;
     }
 
     /// What the photon passes of this render depend on besides the pass index: the photon settings
@@ -1165,6 +1230,9 @@ private:
     std::shared_ptr<const PhotonBeamMap> beams_;  ///< or its beams (photonBeams)
     std::shared_ptr<PhotonCache> cache_;
     int photonsPerPass_ = 0;  ///< settings.photonsPerPass, or the automatic count (decidePasses)
+    int resizedPhotons_ = 0;  ///< the automatic count from pass PhotonNoisePasses on (0: photonsPerPass_)
+    bool measureNoise_ = false;  ///< the automatic count is to be measured (photonNoiseMeasured)
+    bool measuringNoise_ = false;  ///< this pass's gathers report their halves' difference
     std::unique_ptr<Integrator> cameraPaths_;  ///< integrator = combined: the path tracer's (PhotonEstimate)
     std::function<work::Count()> cameraPilot_;  ///< Renderer's camera-pass pilot (setCameraPilot)
     work::Count cameraWork_;  ///< the work of a camera pass without photons (cameraPilot_)

@@ -51,6 +51,7 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["photonsStored"] = VtValue(static_cast<uint64_t>(_stats.photonsStored));
     d["photonRadius"] = VtValue(_stats.photonRadius);
     d["photonsPerPass"] = VtValue(_stats.photonsPerPass);
+    d["photonsPerPassResized"] = VtValue(_stats.photonsPerPassResized);
     d["photonPassesReused"] = VtValue(_stats.photonPassesReused);
     d["photonsReused"] = VtValue(static_cast<uint64_t>(_stats.photonsReused));
     d["totalSeconds"] = VtValue(_stats.seconds);

@@ -30,6 +30,8 @@ py::dict statsToDict(const RenderStats& s) {
     d["camera_seconds"] = s.cameraSeconds;
     d["photon_radius"] = s.photonRadius;
     d["photons_per_pass"] = s.photonsPerPass;
+    d["photons_per_pass_resized"] = s.photonsPerPassResized;
+    d["photon_variance_share"] = s.photonVarianceShare;
     d["photon_work_ratio"] = s.photonWorkRatio;
     d["camera_pass_work"] = py::dict(py::arg("rays") = s.cameraWork.rays, py::arg("lookups") = s.cameraWork.lookups);
     d["photon_work"] = py::dict(py::arg("rays") = s.photonWork.rays, py::arg("lookups") = s.photonWork.lookups);

@@ -78,7 +78,8 @@ std::vector<SettingInfo> makeTable() {
     t.push_back(intSetting("threads", 0, 4096, "--threads", "threadLimit", "Thread limit (0: all cores)", "",
                            "render threads; 0: all cores", &RS::threads));
     t.push_back(intSetting("photonsPerPass", 0, Big, "--photons", "volphoton:photonsPerPass", "Photons per pass (0: auto)", "",
-                           "photonMap: photons traced per pass (0: as many as cost one camera pass, in [4096, 1e6])", &RS::photonsPerPass));
+                           "photonMap: photons traced per pass (0: as many as cost one camera pass, in [4096, 1e6], raised up to 8x "
+                           "after 2 passes where the photon map's measured noise outweighs its cost)", &RS::photonsPerPass));
     t.push_back(doubleSetting("initialRadius", 0, Big, "", "Initial photon radius (0: auto)", "scene units",
                               "photonMap: beam radius of pass 0 (0: 1/100 of the media's diameter)", &RS::initialRadius));
     t.push_back(doubleSetting("radiusAlpha", 1e-6, 1, "", "Photon radius reduction (alpha)", "",

@@ -637,6 +637,8 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "samples_per_pixel": rstats["passes"],
             "photons_traced": rstats["photons_traced"],
             "photons_per_pass": rstats["photons_per_pass"],
+            "photons_per_pass_resized": rstats["photons_per_pass_resized"],
+            "photon_variance_share": rstats["photon_variance_share"],
             "photon_passes_reused": rstats["photon_passes_reused"],
             "photons_reused": rstats["photons_reused"],
             "photons_stored": rstats["photons_stored"],
