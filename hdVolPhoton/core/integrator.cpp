@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 
 #include "core/diagnostics.h"
@@ -463,10 +464,14 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     auto photonsDone = std::chrono::steady_clock::now();
     Camera camera(scene_->desc().camera, settings_.width, settings_.height);
     std::atomic<bool> cancelled{false};
+    static_assert(PhotonNoisePasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
     const bool measureNoise = integrator_->measuresPhotonNoise() && photonNoisePasses_ < PhotonNoisePasses;
-    if (measureNoise && photonNoise_.empty()) photonNoise_.resize(active_.size());
+    if (measureNoise && photonNoisePasses_ == 0) photonNoiseFirst_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
     const int tile = 16;
     int tilesX = (settings_.width + tile - 1) / tile, tilesY = (settings_.height + tile - 1) / tile;
+    // Per tile (each tile is one thread's at a time), summed in tile order below: the same on any
+    // number of threads.
+    std::vector<PhotonNoiseSums> noiseTiles(measureNoise ? size_t(tilesX) * tilesY : 0);
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tilesY, 0, tilesX), [&](const tbb::blocked_range2d<int>& r) {
         for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
             for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
@@ -491,10 +496,16 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                                 if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
                             } else if (measureNoise && !light && L.photonSplit.isFinite()) {
                                 // One sample a pass (light pixels, with several, are left out).
-                                PhotonNoisePixel& m = photonNoise_[static_cast<size_t>(y) * settings_.width + x];
-                                if (m.samples == photonNoisePasses_) {
-                                    m.x[m.samples++] = L.beauty().average();
-                                    m.split2 += L.photonSplit.average() * L.photonSplit.average();
+                                PhotonNoiseSums& sums = noiseTiles[size_t(ty) * tilesX + tx];
+                                const double split = L.photonSplit.average(), value = L.beauty().average();
+                                sums.photon += split * split;
+                                ++sums.photonPixels;
+                                float& first = photonNoiseFirst_[static_cast<size_t>(y) * settings_.width + x];
+                                if (photonNoisePasses_ == 0) {
+                                    first = static_cast<float>(value);
+                                } else if (!std::isnan(first)) {
+                                    sums.whole += 0.5 * (value - first) * (value - first);
+                                    ++sums.wholePixels;
                                 }
                             }
                             film_.add(x, y, L);
@@ -508,7 +519,22 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
         for (const LightPixel& p : lightPixels_) stats_.cameraSamples += active_[p.index] ? LightPixelSamples - 1 : 0;
         ++pass_;
         ++stats_.passes;
-        if (measureNoise && ++photonNoisePasses_ == PhotonNoisePasses) measurePhotonNoise();
+        if (measureNoise) {
+            for (const PhotonNoiseSums& t : noiseTiles) {
+                photonNoise_.photon += t.photon;
+                photonNoise_.photonPixels += t.photonPixels;
+                photonNoise_.whole += t.whole;
+                photonNoise_.wholePixels += t.wholePixels;
+            }
+            if (++photonNoisePasses_ == PhotonNoisePasses) {
+                // The photon map's share of a sample's variance and the whole, to the integrator, which
+                // sizes its later photon passes by them (PhotonMapper, "how many photons").
+                photonNoiseFirst_ = {};
+                const PhotonNoiseSums& n = photonNoise_;
+                if (n.photonPixels > 0 && n.wholePixels > 0)
+                    integrator_->photonNoiseMeasured(n.photon / n.photonPixels, n.whole / n.wholePixels, n.wholePixels, stats_);
+            }
+        }
         updateAdaptive();  // timed with the pass: the time limit counts it
     }
     auto end = std::chrono::steady_clock::now();
@@ -525,23 +551,6 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
         return false;
     }
     return true;
-}
-
-/// The photon map's share of a sample's variance and the whole, over the pixels that took a sample in
-/// every measurement pass (summed in pixel order: the same on any number of threads), to the
-/// integrator, which sizes its later photon passes by them (PhotonMapper, "how many photons").
-void Renderer::measurePhotonNoise() {
-    static_assert(PhotonNoisePasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
-    double photon = 0, whole = 0;
-    int pixels = 0;
-    for (const PhotonNoisePixel& m : photonNoise_) {
-        if (m.samples != PhotonNoisePasses) continue;
-        photon += m.split2 / PhotonNoisePasses;
-        whole += 0.5 * (m.x[1] - m.x[0]) * (m.x[1] - m.x[0]);
-        ++pixels;
-    }
-    photonNoise_ = {};
-    if (pixels > 0) integrator_->photonNoiseMeasured(photon / pixels, whole / pixels, pixels, stats_);
 }
 
 void Renderer::updateAdaptive() {

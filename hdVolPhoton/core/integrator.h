@@ -256,7 +256,8 @@ class PhotonCache;
 /// the variance at equal cost. r is not known before rendering and ranges widely: 11 on
 /// testenv/test_adaptive.py's slab (photon noise dominates), about 0.04 on the fog + spot benchmark
 /// scene (the single-scattering march dominates). Equal cost is at most 1.3x (slab) and 1.45x (fog)
-/// slower than the best split for either; twice the balance would be 1.05x and 2.1x.
+/// slower than the best split for either; twice the balance would be 1.05x and 2.1x. So passes
+/// start at equal cost, and the first PhotonNoisePasses measure r and raise the count (below).
 /// The former fixed 1e5 made a 4 x 4-pixel check 14x slower (vdb_cloud, 64 passes: 3.45 s of photons
 /// against 0.24 s at 4096).
 constexpr int MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
@@ -336,16 +337,16 @@ private:
     std::vector<uint8_t> active_;
     double lastPassSeconds_ = 0;  ///< the last pass's seconds: the time the next is expected to take
     bool usesPhotons_ = false;  ///< the photon-map integrator renders (the scene has media)
-    /// The photon-noise measurement passes (Integrator::measuresPhotonNoise), per pixel: the beauty's
-    /// channel average of each pass's sample and the squared photonSplit's, summed. Freed after them.
-    struct PhotonNoisePixel {
-        double x[PhotonNoisePasses] = {};
-        double split2 = 0;
-        int samples = 0;  ///< measurement passes that gave this pixel one usable sample
+    /// The photon-noise measurement passes (Integrator::measuresPhotonNoise): each pixel's first sample
+    /// (the beauty's channel average; NaN: none), freed after them, and the sums over the pixels of the
+    /// squared photonSplit and of the two samples' spread (x1 - x0)^2 / 2, with their pixel counts.
+    std::vector<float> photonNoiseFirst_;
+    struct PhotonNoiseSums {
+        double photon = 0, whole = 0;
+        int64_t photonPixels = 0, wholePixels = 0;
     };
-    std::vector<PhotonNoisePixel> photonNoise_;
+    PhotonNoiseSums photonNoise_;
     int photonNoisePasses_ = 0;
-    void measurePhotonNoise();
     /// Pixels whose footprint holds the image of a point-like light (Light::equiangularCenter) in a
     /// scene with media, sorted by pixel index: their camera samples take positions from
     /// samplePixelAroundPoint (sampling.h), whose variance stays bounded where the medium's scattered

@@ -225,7 +225,7 @@ public:
     /// After the measurement passes: `photonVariance`, the mean over pixels of the photon map's share
     /// of a sample's variance (from photonSplit), and `sampleVariance`, a sample's whole variance
     /// (from the spread of the passes), both of the beauty's channel average.
-    virtual void photonNoiseMeasured(double photonVariance, double sampleVariance, int pixels, RenderStats& stats) {
+    virtual void photonNoiseMeasured(double photonVariance, double sampleVariance, int64_t pixels, RenderStats& stats) {
         (void)photonVariance; (void)sampleVariance; (void)pixels; (void)stats;
     }
     /// The denoiser guides of a camera ray (integrator.h, "AOVs"): *albedo and *normal at its first

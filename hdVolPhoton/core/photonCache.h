@@ -18,8 +18,10 @@ class PhotonBeamMap;
 /// lights, media and geometry do not vary. The photon-map integrator then takes pass i's photon map
 /// from the cache when pass i was traced before under the same key, and stores the maps it traces
 /// while their total size stays within RenderSettings::photonMapBudgetBytes (later passes are traced
-/// each time). A pass's photons depend only on the scene, the seed and the pass index, so a reused
-/// pass is bit-identical to a traced one: a render with a cache is the render without one, faster.
+/// each time). A pass's photons depend only on the scene, the seed, the pass index and the count, so
+/// a reused pass is bit-identical to a traced one: a render with a cache is the render without one,
+/// faster. (An automatic count follows the cache's: its start and the later count its first render
+/// measured, which depends on that render's view and image size.)
 ///
 /// The key (set by the integrator at the start of each render, PhotonMapper::photonKey) hashes the
 /// photon settings and the records of the deterministic pilot photons (positions, directions,

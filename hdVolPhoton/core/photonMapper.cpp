@@ -209,7 +209,7 @@ public:
     // noise; the bench README, "Scenes 8-10 at the automatic photon count", and the 2026-12-07 note.)
     bool measuresPhotonNoise() const override { return measuringNoise_; }
 
-    void photonNoiseMeasured(double photonVariance, double sampleVariance, int pixels, RenderStats& stats) override {
+    void photonNoiseMeasured(double photonVariance, double sampleVariance, int64_t pixels, RenderStats& stats) override {
         measureNoise_ = measuringNoise_ = false;
         const double s = photonVariance, v = sampleVariance;
         stats.photonVarianceShare = v > 0 ? s / v : 0.0;
@@ -226,7 +226,8 @@ public:
         if (cache_) cache_->setResizedPhotonsPerPass(resizedPhotons_);
         char text[200];
         std::snprintf(text, sizeof text, "photons: %d a pass for %d passes, then %d (the photon map's share of a sample's variance %.2g, "
-                      "measured over %d pixels)", photonsPerPass_, PhotonNoisePasses, resizedPhotons_, stats.photonVarianceShare, pixels);
+                      "measured over %lld pixels)", photonsPerPass_, PhotonNoisePasses, resizedPhotons_, stats.photonVarianceShare,
+                      static_cast<long long>(pixels));
         stats.passesRun.push_back(text);
     }
 
