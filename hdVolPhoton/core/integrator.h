@@ -173,7 +173,7 @@ struct RenderStats {
     uint64_t photonsStored = 0;
     double seconds = 0, photonSeconds = 0, cameraSeconds = 0;
     double photonRadius = 0;
-    int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic), 0 without photons
+    int photonsPerPass = 0;          ///< photonMap: the count used (settings' or automatic; of the first passes where it was resized), 0 without photons
     /// An automatic count's size from pass PhotonNoisePasses on, measured by the first passes (at least
     /// photonsPerPass; 0: not measured)
     int photonsPerPassResized = 0;
