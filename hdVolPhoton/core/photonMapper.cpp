@@ -219,9 +219,10 @@ public:
             const double b = std::max(v - s, v / CameraShareFloor);
             best = std::sqrt(s * photonsPerPass_ * balance / b);
         }
-        resizedPhotons_ = static_cast<int>(std::clamp(best, double(photonsPerPass_),
-                                                      std::min(double(MaxPhotonGrowth) * photonsPerPass_, double(MaxAutoPhotons))));
-        resizedPhotons_ = std::max(resizedPhotons_, photonsPerPass_);
+        // Never below the start: a count followed from a cache may exceed MaxAutoPhotons (an explicit
+        // count cached before), and then stays as it is.
+        const double most = std::max(double(photonsPerPass_), std::min(double(MaxPhotonGrowth) * photonsPerPass_, double(MaxAutoPhotons)));
+        resizedPhotons_ = static_cast<int>(std::clamp(best, double(photonsPerPass_), most));
         stats.photonsPerPassResized = resizedPhotons_;
         if (cache_) cache_->setResizedPhotonsPerPass(resizedPhotons_);
         char text[200];
