@@ -12,6 +12,7 @@
 #include "core/diagnostics.h"
 #include "core/freeFlight.h"
 #include "core/integratorBase.h"
+#include "core/photonCache.h"
 #include "core/workCount.h"
 
 namespace volphoton {
@@ -366,6 +367,13 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     }
     usesPhotons_ = photonMapper;
     stats_.integratorUsed = photonMapper ? (combined ? "combined" : "photonMap") : "pathTracer";
+    // The measured choice (renderPass): combined with the automatic share measures its photons against
+    // the path tracer, unless a delta light reaches translucent objects only as photons, the photon count
+    // is the settings' (then its noise is not measured either), or the render is too short for it.
+    if (photonMapper && combined && settings_.combinedPhotonShare < 0 && !(choice && choice->photonsOnly) &&
+        settings_.photonsPerPass == 0 && (settings_.progressive() || settings_.samplesPerPixel >= MinTrialRenderPasses))
+        trial_ = Trial::Photons;
+    photonCache_ = photonCache;
     integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache), openMediaSegments) : makePathTracer(*scene_, settings_);
     if (scene_->hasMedia()) {
         Camera camera(scene_->desc().camera, settings_.width, settings_.height);
@@ -434,7 +442,7 @@ const ImagePoint* Renderer::lightPixel(int x, int y) const {
     return it != lightPixels_.end() && it->index == index ? &it->light : nullptr;
 }
 
-work::Count Renderer::cameraPilotWork() const {
+work::Count Renderer::cameraPilotWork(const Integrator& integrator) const {
     // One sample at the centre of each cell of a 16 x 16 grid over the image (fewer where the image
     // is smaller): every row and column band is seen (a stride through the pixel index fell on 16
     // columns at 320 wide).
@@ -446,7 +454,7 @@ work::Count Renderer::cameraPilotWork() const {
         for (int gx = 0; gx < nx; ++gx) {
             Rng rng(hashKeys(0x50494c4fULL, settings_.seed, gy * nx + gx));
             PathRadiance L;
-            cameraSample(*integrator_, camera, (2 * gx + 1) * w / (2 * nx), (2 * gy + 1) * h / (2 * ny), rng, &L);
+            cameraSample(integrator, camera, (2 * gx + 1) * w / (2 * nx), (2 * gy + 1) * h / (2 * ny), rng, &L);
         }
     return work::since(before) * (double(w) * h / (nx * ny));
 }
@@ -456,22 +464,41 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     auto threads = limitThreads(settings_);
     // The photon map's automatic photon count weighs a camera pass's work (deterministic pilot, run
     // by beginPass on this thread: work is counted per thread) against a photon's.
-    if (pass_ == 0 && usesPhotons_ && settings_.photonsPerPass == 0) integrator_->setCameraPilot([this] { return cameraPilotWork(); });
-    if (!integrator_->beginPass(pass_, stats_, cancel)) {
-        stats_.cancelled = true;
-        return false;
+    if (pass_ == 0 && usesPhotons_ && settings_.photonsPerPass == 0) integrator_->setCameraPilot([this] { return cameraPilotWork(*integrator_); });
+    // The path tracer's trial passes (the measured choice) leave the photon integrator alone.
+    const bool trialPass = trial_ == Trial::PathTracer;
+    if (!trialPass) {
+        if (!integrator_->beginPass(integratorPass_, stats_, cancel)) {
+            stats_.cancelled = true;
+            return false;
+        }
+        ++integratorPass_;
+    }
+    if (pass_ == 0 && trial_ == Trial::Photons) {
+        // A render that follows cached maps follows their measured choice too; one whose photon count
+        // is not measured (photons skipped, or a cache's count) is not compared either.
+        PhotonCache::Choice cached = photonCache_ ? photonCache_->measuredChoice() : PhotonCache::Choice::Unmeasured;
+        if (cached == PhotonCache::Choice::PathTracer)
+            switchToPathTracer(makePathTracer(*scene_, settings_), "the path tracer, as measured by an earlier render of these photon maps");
+        else if (cached == PhotonCache::Choice::Photons || !integrator_->measuresPhotonNoise())
+            trial_ = Trial::Off;
     }
     auto photonsDone = std::chrono::steady_clock::now();
     Camera camera(scene_->desc().camera, settings_.width, settings_.height);
     std::atomic<bool> cancelled{false};
-    static_assert(PhotonNoisePasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
-    const bool measureNoise = integrator_->measuresPhotonNoise() && photonNoisePasses_ < PhotonNoisePasses;
-    if (measureNoise && photonNoisePasses_ == 0) photonNoiseFirst_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
+    static_assert(PhotonNoisePasses == 2 && TrialPasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
+    const bool measureNoise = !trialPass && integrator_->measuresPhotonNoise() && photonNoisePasses_ < PhotonNoisePasses;
+    // Which of its two samples this pass gives a pixel's spread: the photon measurement's or the trial's.
+    const int spreadSample = measureNoise ? photonNoisePasses_ : trialPass ? pass_ - PhotonNoisePasses : -1;
+    if (spreadSample == 0) photonNoiseFirst_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
+    if (measureNoise && spreadSample == 0 && trial_ == Trial::Photons)
+        trialPhotonMean_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
+    const Integrator& integrator = trialPass ? *trialPathTracer_ : *integrator_;
     const int tile = 16;
     int tilesX = (settings_.width + tile - 1) / tile, tilesY = (settings_.height + tile - 1) / tile;
     // Per tile (each tile is one thread's at a time), summed in tile order below: the same on any
     // number of threads.
-    std::vector<PhotonNoiseSums> noiseTiles(measureNoise ? size_t(tilesX) * tilesY : 0);
+    std::vector<PhotonNoiseSums> noiseTiles(spreadSample >= 0 ? size_t(tilesX) * tilesY : 0);
     tbb::parallel_for(tbb::blocked_range2d<int>(0, tilesY, 0, tilesX), [&](const tbb::blocked_range2d<int>& r) {
         for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
             for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
@@ -490,22 +517,32 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                             rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
                             PathRadiance L;
                             Rng guideRng(hashKeys(x, y, settings_.seed, 0x6775696465ULL), sample);  // "guide"
-                            if (!cameraSample(*integrator_, camera, x, y, rng, &L, settings_.guideAovs ? &guideRng : nullptr, light)) {
+                            if (!cameraSample(integrator, camera, x, y, rng, &L, settings_.guideAovs ? &guideRng : nullptr, light)) {
                                 // never on the film: dropped, and reported
                                 static std::atomic<int> reported{0};
                                 if (reported++ < 5) warn("dropped a non-finite or negative sample at pixel " + std::to_string(x) + "," + std::to_string(y));
-                            } else if (measureNoise && !light && L.photonSplit.isFinite()) {
+                            } else if (spreadSample >= 0 && !light && L.photonSplit.isFinite()) {
                                 // One sample a pass (light pixels, with several, are left out).
                                 PhotonNoiseSums& sums = noiseTiles[size_t(ty) * tilesX + tx];
                                 const double split = L.photonSplit.average(), value = L.beauty().average();
                                 sums.photon += split * split;
                                 ++sums.photonPixels;
                                 float& first = photonNoiseFirst_[static_cast<size_t>(y) * settings_.width + x];
-                                if (photonNoisePasses_ == 0) {
+                                if (spreadSample == 0) {
                                     first = static_cast<float>(value);
                                 } else if (!std::isnan(first)) {
                                     sums.whole += 0.5 * (value - first) * (value - first);
                                     ++sums.wholePixels;
+                                    const size_t i = static_cast<size_t>(y) * settings_.width + x;
+                                    if (measureNoise && !trialPhotonMean_.empty()) {
+                                        trialPhotonMean_[i] = 0.5f * (first + static_cast<float>(value));
+                                    } else if (trialPass && !std::isnan(trialPhotonMean_[i])) {
+                                        const double d = 0.5 * (first + value) - trialPhotonMean_[i];
+                                        sums.difference += d * d;
+                                        sums.differenceSum += d;
+                                        sums.photonMeanSum += trialPhotonMean_[i];
+                                        ++sums.differencePixels;
+                                    }
                                 }
                             }
                             film_.add(x, y, L);
@@ -519,20 +556,27 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
         for (const LightPixel& p : lightPixels_) stats_.cameraSamples += active_[p.index] ? LightPixelSamples - 1 : 0;
         ++pass_;
         ++stats_.passes;
-        if (measureNoise) {
-            for (const PhotonNoiseSums& t : noiseTiles) {
-                photonNoise_.photon += t.photon;
-                photonNoise_.photonPixels += t.photonPixels;
-                photonNoise_.whole += t.whole;
-                photonNoise_.wholePixels += t.wholePixels;
-            }
-            if (++photonNoisePasses_ == PhotonNoisePasses) {
-                // The photon map's share of a sample's variance and the whole, to the integrator, which
-                // sizes its later photon passes by them (PhotonMapper, "how many photons").
-                photonNoiseFirst_ = {};
-                const PhotonNoiseSums& n = photonNoise_;
-                if (n.photonPixels > 0 && n.wholePixels > 0)
-                    integrator_->photonNoiseMeasured(n.photon / n.photonPixels, n.whole / n.wholePixels, n.wholePixels, stats_);
+        PhotonNoiseSums& spread = measureNoise ? photonNoise_ : trialSpread_;
+        for (const PhotonNoiseSums& t : noiseTiles) {
+            spread.photon += t.photon;
+            spread.photonPixels += t.photonPixels;
+            spread.whole += t.whole;
+            spread.wholePixels += t.wholePixels;
+            spread.difference += t.difference;
+            spread.differenceSum += t.differenceSum;
+            spread.photonMeanSum += t.photonMeanSum;
+            spread.differencePixels += t.differencePixels;
+        }
+        if (measureNoise && ++photonNoisePasses_ == PhotonNoisePasses) {
+            // The photon map's share of a sample's variance and the whole, to the integrator, which
+            // sizes its later photon passes by them (PhotonMapper, "how many photons").
+            photonNoiseFirst_ = {};
+            const PhotonNoiseSums& n = photonNoise_;
+            if (n.photonPixels > 0 && n.wholePixels > 0)
+                integrator_->photonNoiseMeasured(n.photon / n.photonPixels, n.whole / n.wholePixels, n.wholePixels, stats_);
+            if (trial_ == Trial::Photons) {
+                trial_ = n.photonPixels > 0 && n.wholePixels > 0 ? Trial::PathTracer : Trial::Off;
+                if (trial_ == Trial::PathTracer) trialPathTracer_ = makePathTracer(*scene_, settings_);
             }
         }
         updateAdaptive();  // timed with the pass: the time limit counts it
@@ -542,15 +586,89 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     stats_.cameraSeconds += std::chrono::duration<double>(end - photonsDone).count();
     stats_.seconds += std::chrono::duration<double>(end - start).count();
     lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
-    // The next pass's photons, where the measurement just raised their count, take that much longer.
-    if (pass_ == PhotonNoisePasses && stats_.photonsPerPassResized > stats_.photonsPerPass && stats_.photonsPerPass > 0)
-        lastPassSeconds_ += std::chrono::duration<double>(photonsDone - start).count() *
-                            (double(stats_.photonsPerPassResized) / stats_.photonsPerPass - 1);
+    // The next photon pass's photons, where the measurement just raised their count, take that much
+    // longer (the pass after the trial's, if the photons win it).
+    if (pass_ == PhotonNoisePasses && !trialPass) {
+        photonPassSeconds_ = lastPassSeconds_;
+        if (stats_.photonsPerPassResized > stats_.photonsPerPass && stats_.photonsPerPass > 0)
+            photonPassSeconds_ += std::chrono::duration<double>(photonsDone - start).count() *
+                                  (double(stats_.photonsPerPassResized) / stats_.photonsPerPass - 1);
+        if (trial_ != Trial::PathTracer) lastPassSeconds_ = photonPassSeconds_;
+    }
+    if (!cancelled && trialPass && pass_ == PhotonNoisePasses + TrialPasses) decideTrial();
     if (cancelled) {
         stats_.cancelled = true;
         return false;
     }
     return true;
+}
+
+// ---- the measured choice ---------------------------------------------------------------------
+// combined with the automatic share renders with photons where auto's pilot finds them leading
+// (translucent objects, and open media where the image is large enough), a guess from the view. The
+// render measures it instead: its first PhotonNoisePasses passes (which also size the photon count)
+// are followed by TrialPasses passes of the path tracer, and each side's cost to a given noise, the
+// variance of a sample times the work of a pass, decides which renders the rest. The photons' side is
+// taken at the resized count: b + a P0 / P1 (a: the photon map's share of the variance measured at
+// P0 photons, b the rest, floored as in PhotonMapper) times the work of a camera pass plus P1 photons;
+// the path tracer's its two passes' spread times its camera pilot's work. Work in deterministic units
+// (workCount.h), not seconds, so the choice and the image are the same on every machine. Both sides'
+// variance comes from a pixel's two samples, whose Sobol' points are a stratified pair, so both are
+// overstated alike. The kernel's bias is not in the comparison (it falls with the passes).
+// Two samples cannot show a variance made of rare events: a path tracer that finds a small light only
+// by chance (seen through a dielectric, where no shadow ray reaches it) has two samples of 0 in most
+// pixels, a spread near 0 and an enormous variance (TheMeasuredChoiceKeepsTheCheaperSide: 600x the
+// photons' at equal time). Its mean betrays it: the light it missed. So the path tracer is taken only
+// where its trial image's mean is within ShortfallTolerance (the photons' kernel bias) plus 4 standard
+// errors of the photon passes' mean.
+// The loser's samples stay in the film (both sides estimate the same image): 2 of the render's passes.
+void Renderer::decideTrial() {
+    constexpr double ShortfallTolerance = 0.02;
+    const PhotonNoiseSums& n = photonNoise_;
+    const PhotonNoiseSums& t = trialSpread_;
+    const double s = n.photon / n.photonPixels, v = n.whole / n.wholePixels;
+    const double p0 = stats_.photonsPerPass, p1 = std::max(p0, double(stats_.photonsPerPassResized));
+    const double photonVariance = std::max(v - s, v / CameraShareFloor) + s * p0 / p1;
+    const double photonWork = stats_.cameraWork.units() + p1 * work::photonUnits(stats_.photonWork, stats_.gatherWork);
+    const double pathVariance = t.wholePixels > 0 ? t.whole / t.wholePixels : Infinity;
+    const double pathWork = cameraPilotWork(*trialPathTracer_).units();
+    stats_.measuredPhotonCost = photonVariance * photonWork;
+    stats_.measuredPathTracerCost = pathVariance * pathWork;
+    // The two images' means over the pixels that have both (d: a pixel's path-traced mean minus its
+    // photon mean), and the standard error of their difference from the pixels' spread of d.
+    const double pixels = double(std::max<int64_t>(t.differencePixels, 1));
+    const double photonMean = t.photonMeanSum / pixels, shortfall = -t.differenceSum / pixels;
+    const double error = std::sqrt(std::max(0.0, t.difference / pixels - shortfall * shortfall) / pixels);
+    const bool fallsShort = shortfall > ShortfallTolerance * std::abs(photonMean) + 4 * error;
+    photonNoiseFirst_ = {};
+    trialPhotonMean_ = {};
+    char text[320];
+    int at = std::snprintf(text, sizeof text, "measured on passes 1-%d: variance x work a pass %.3g with photons, %.3g with the path tracer (%.2fx)",
+                           PhotonNoisePasses + TrialPasses, stats_.measuredPhotonCost, stats_.measuredPathTracerCost,
+                           stats_.measuredPathTracerCost / stats_.measuredPhotonCost);
+    if (fallsShort && at > 0 && at < int(sizeof text))
+        std::snprintf(text + at, sizeof text - at, ", but its image %.1f%% darker than the photons' (light it finds only by chance)",
+                      100 * shortfall / std::max(photonMean, 1e-300));
+    if (!fallsShort && stats_.measuredPathTracerCost < stats_.measuredPhotonCost) {
+        if (photonCache_) photonCache_->setMeasuredChoice(PhotonCache::Choice::PathTracer);
+        switchToPathTracer(std::move(trialPathTracer_), std::string(text) + ": the path tracer renders the rest");
+        return;
+    }
+    if (photonCache_) photonCache_->setMeasuredChoice(PhotonCache::Choice::Photons);
+    trial_ = Trial::Done;
+    trialPathTracer_.reset();
+    stats_.passesRun.push_back(std::string(text) + ": combined renders the rest");
+    stats_.integratorReason += "; " + std::string(text) + ": combined kept";
+    lastPassSeconds_ = photonPassSeconds_;
+}
+
+void Renderer::switchToPathTracer(std::unique_ptr<Integrator> pathTracer, const std::string& why) {
+    integrator_ = std::move(pathTracer);  // frees the photon maps (a cache keeps its own)
+    trial_ = Trial::Done;
+    usesPhotons_ = false;
+    stats_.integratorUsed = "pathTracer";
+    stats_.integratorReason += (stats_.integratorReason.empty() ? "" : "; ") + why;
+    stats_.passesRun.push_back("path tracer: " + why);
 }
 
 void Renderer::updateAdaptive() {

@@ -179,6 +179,10 @@ struct RenderStats {
     int photonsPerPassResized = 0;
     /// The photon map's share of a camera sample's variance in the measurement passes (-1: not measured)
     double photonVarianceShare = -1;
+    /// combined with the automatic photon share: the measured choice between its photons and the path
+    /// tracer (Renderer, "the measured choice"): each side's variance of a sample times the work of a
+    /// pass (work units, workCount.h), lower is better; 0: not measured
+    double measuredPhotonCost = 0, measuredPathTracerCost = 0;
     /// photonMap: photons whose tracing and gathers cost as much as a camera pass (pilots; 0: not measured)
     double photonWorkRatio = 0;
     /// photonMap pilots: rays and lookups of a camera pass without photons, of tracing a photon, and
@@ -267,6 +271,11 @@ constexpr int MinAutoPhotons = 4096, MaxAutoPhotons = 1000000;
 /// difference of two measured variances, noisy where the photons are nearly all of it).
 constexpr int PhotonNoisePasses = 2, MaxPhotonGrowth = 8;
 constexpr double CameraShareFloor = 64;
+/// The measured choice (Renderer): combined's first PhotonNoisePasses passes (its photons) are
+/// followed by TrialPasses passes of the path tracer, and the one whose variance x work is lower
+/// renders the rest; only in renders of at least MinTrialRenderPasses passes (or progressive ones),
+/// where the loser's few samples weigh little.
+constexpr int TrialPasses = 2, MinTrialRenderPasses = 16;
 constexpr double PhotonShare = 1.0;
 inline int autoPhotonsPerPass(double balance) {
     if (!(balance > 0)) return MinAutoPhotons;
@@ -344,9 +353,28 @@ private:
     struct PhotonNoiseSums {
         double photon = 0, whole = 0;
         int64_t photonPixels = 0, wholePixels = 0;
+        /// The trial's: the squared difference of a pixel's two path-traced samples' mean and its
+        /// two photon samples' mean (Renderer, "the measured choice")
+        double difference = 0, differenceSum = 0, photonMeanSum = 0;  ///< sums of d^2, d, the photon mean
+        int64_t differencePixels = 0;
     };
     PhotonNoiseSums photonNoise_;
     int photonNoisePasses_ = 0;
+    /// The measured choice (combined with the automatic share, renderPass): Photons while combined's
+    /// measurement passes run, PathTracer while the path tracer's trial passes run, then Done (or
+    /// Off: not measured).
+    enum class Trial { Off, Photons, PathTracer, Done };
+    Trial trial_ = Trial::Off;
+    std::unique_ptr<Integrator> trialPathTracer_;  ///< the path tracer of the trial passes
+    PhotonNoiseSums trialSpread_;  ///< the trial passes' spread (whole, wholePixels) and difference
+    std::vector<float> trialPhotonMean_;  ///< each pixel's mean of its two photon samples (NaN: none)
+    double photonPassSeconds_ = 0;  ///< a photon pass's expected seconds once the count is resized
+    std::shared_ptr<PhotonCache> photonCache_;
+    int integratorPass_ = 0;  ///< passes integrator_ has begun (its photon passes' index)
+    /// The path tracer renders from the next pass on (the trial's outcome, or a cache's): `why`.
+    void switchToPathTracer(std::unique_ptr<Integrator> pathTracer, const std::string& why);
+    /// After the trial passes: compares the two sides and keeps the better.
+    void decideTrial();
     /// Pixels whose footprint holds the image of a point-like light (Light::equiangularCenter) in a
     /// scene with media, sorted by pixel index: their camera samples take positions from
     /// samplePixelAroundPoint (sampling.h), whose variance stays bounded where the medium's scattered
@@ -365,7 +393,7 @@ private:
     const ImagePoint* lightPixel(int x, int y) const;
     /// The work (core/workCount.h) of one camera pass, from deterministic camera samples at the
     /// centres of a 16 x 16 grid over the image.
-    work::Count cameraPilotWork() const;
+    work::Count cameraPilotWork(const Integrator& integrator) const;
     /// After a pass: the active mask and the error statistics from the film.
     void updateAdaptive();
 };

@@ -16,6 +16,7 @@ bool PhotonCache::use(uint64_t key) {
     bytes_ = 0;
     photonsPerPass_ = 0;
     resizedPhotonsPerPass_ = 0;
+    measuredChoice_ = Choice::Unmeasured;
     key_ = key;
     hasKey_ = true;
     return false;
@@ -57,6 +58,16 @@ void PhotonCache::setResizedPhotonsPerPass(int n) {
     resizedPhotonsPerPass_ = n;
 }
 
+PhotonCache::Choice PhotonCache::measuredChoice() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return measuredChoice_;
+}
+
+void PhotonCache::setMeasuredChoice(Choice c) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    measuredChoice_ = c;
+}
+
 size_t PhotonCache::passes() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return passes_.size();
@@ -73,6 +84,7 @@ void PhotonCache::clear() {
     bytes_ = 0;
     photonsPerPass_ = 0;
     resizedPhotonsPerPass_ = 0;
+    measuredChoice_ = Choice::Unmeasured;
     hasKey_ = false;
 }
 

@@ -58,6 +58,11 @@ public:
     /// not measured): a render that follows the cached count follows this too.
     int resizedPhotonsPerPass() const;
     void setResizedPhotonsPerPass(int n);
+    /// combined's measured choice (Renderer, "the measured choice") over the cached maps: a later
+    /// render of the same content (a camera move) follows it instead of measuring again.
+    enum class Choice { Unmeasured, Photons, PathTracer };
+    Choice measuredChoice() const;
+    void setMeasuredChoice(Choice c);
     size_t passes() const;
     size_t bytes() const;
     void clear();
@@ -67,6 +72,7 @@ private:
     uint64_t key_ = 0;
     bool hasKey_ = false;
     int photonsPerPass_ = 0, resizedPhotonsPerPass_ = 0;
+    Choice measuredChoice_ = Choice::Unmeasured;
     size_t bytes_ = 0;
     std::map<int, std::shared_ptr<const Pass>> passes_;
 };

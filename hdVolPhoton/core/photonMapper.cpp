@@ -1169,7 +1169,7 @@ private:
             stats.gatherWork = work::Count{std::max(0.0, gather.rays), std::max(0.0, gather.lookups), std::max(0.0, gather.gathers)} *
                                (1.0 / PilotPhotons);
         }
-        double workPerPhoton = work::PhotonBaseCost + stats.photonWork.units(work::PhotonLookupCost) + stats.gatherWork.units();
+        double workPerPhoton = work::photonUnits(stats.photonWork, stats.gatherWork);
         double workPerCameraPass = cameraWork_.units();
         stats.photonWorkRatio = workPerCameraPass > 0 && workPerPhoton > 0 ? workPerCameraPass / workPerPhoton : 0.0;
         photonsPerPass_ = settings_.photonsPerPass > 0 ? settings_.photonsPerPass : autoPhotonsPerPass(stats.photonWorkRatio);

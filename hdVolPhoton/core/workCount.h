@@ -54,6 +54,11 @@ struct Count {
     Count operator*(double f) const { return {rays * f, lookups * f, gathers * f}; }
 };
 using Snapshot = Count;
+/// The work of one photon (the automatic photon count, the measured choice): its fixed cost, its
+/// tracing's rays and lookups, and the gathers it adds to a camera pass.
+inline double photonUnits(const Count& tracing, const Count& gathers) {
+    return PhotonBaseCost + tracing.units(PhotonLookupCost) + gathers.units();
+}
 inline Count snapshot() { return {double(rays), lookups, double(gathers)}; }
 /// What this thread counted since `from`.
 inline Count since(const Count& from) { return snapshot() - from; }

@@ -52,6 +52,8 @@ VtDictionary HdVolPhoton_Renderer::GetStats() const {
     d["photonRadius"] = VtValue(_stats.photonRadius);
     d["photonsPerPass"] = VtValue(_stats.photonsPerPass);
     d["photonsPerPassResized"] = VtValue(_stats.photonsPerPassResized);
+    d["measuredPhotonCost"] = VtValue(_stats.measuredPhotonCost);
+    d["measuredPathTracerCost"] = VtValue(_stats.measuredPathTracerCost);
     d["photonPassesReused"] = VtValue(_stats.photonPassesReused);
     d["photonsReused"] = VtValue(static_cast<uint64_t>(_stats.photonsReused));
     d["totalSeconds"] = VtValue(_stats.seconds);

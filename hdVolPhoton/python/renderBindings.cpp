@@ -32,6 +32,8 @@ py::dict statsToDict(const RenderStats& s) {
     d["photons_per_pass"] = s.photonsPerPass;
     d["photons_per_pass_resized"] = s.photonsPerPassResized;
     d["photon_variance_share"] = s.photonVarianceShare;
+    d["measured_photon_cost"] = s.measuredPhotonCost;
+    d["measured_path_tracer_cost"] = s.measuredPathTracerCost;
     d["photon_work_ratio"] = s.photonWorkRatio;
     d["camera_pass_work"] = py::dict(py::arg("rays") = s.cameraWork.rays, py::arg("lookups") = s.cameraWork.lookups);
     d["photon_work"] = py::dict(py::arg("rays") = s.photonWork.rays, py::arg("lookups") = s.photonWork.lookups);

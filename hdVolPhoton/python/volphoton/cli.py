@@ -639,6 +639,8 @@ def _render_frame(core, output, usdscene, args, stage, frame, tc, settings, came
             "photons_per_pass": rstats["photons_per_pass"],
             "photons_per_pass_resized": rstats["photons_per_pass_resized"],
             "photon_variance_share": rstats["photon_variance_share"],
+            "measured_photon_cost": rstats["measured_photon_cost"],
+            "measured_path_tracer_cost": rstats["measured_path_tracer_cost"],
             "photon_passes_reused": rstats["photon_passes_reused"],
             "photons_reused": rstats["photons_reused"],
             "photons_stored": rstats["photons_stored"],
