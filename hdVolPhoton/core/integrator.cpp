@@ -188,6 +188,11 @@ void Integrator::firstVertexGuides(const Ray& cameraRay, double nearClip, double
     }
 }
 
+bool pointLitMedia(const Scene& scene) {
+    return scene.hasMedia() && std::any_of(scene.lights().begin(), scene.lights().end(),
+                                           [](const LightPtr& l) { return l->isDelta() && l->pointPosition().has_value(); });
+}
+
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings) {
     using I = RenderSettings::Integrator;
     if (!scene.hasMedia()) return {I::PathTracer, "the scene has no media"};
@@ -289,6 +294,21 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // 0.92x the path tracer with the cloud on 40% of the view, 1.01x with it on 7%.
     const double pixels = double(std::max(1, settings.width)) * std::max(1, settings.height);
     std::string size = std::to_string(settings.width) + " x " + std::to_string(settings.height) + " pixels";
+    // A render long enough for the measured choice (Renderer: combined's automatic share and photon
+    // count, MinTrialRenderPasses passes or a progressive render) tries the photons on any open media
+    // and keeps them only where they measure cheaper than the path tracer's paths: the rules below,
+    // guesses from the view, are for shorter renders. Points, or beams where the media scatter light
+    // many times (the rule below for 128 x 128 and up).
+    // Point and spot lights are not measured: near one, the path tracer's variance is unbounded
+    // (pointLitMedia), so its photons are kept.
+    const bool measured = settings.photonsPerPass == 0 && settings.combinedPhotonShare < 0 &&
+                          (settings.progressive() || settings.samplesPerPixel >= MinTrialRenderPasses);
+    if (media > 0 && measured && pointLitMedia(scene))
+        return byPhotons("a point or spot light lights these open media, where the path tracer's variance is unbounded",
+                         !thin && albedo >= HighAlbedo);
+    if (media > 0 && measured)
+        return byPhotons("photons tried on these open media at " + size + ", kept if they measure cheaper than the path tracer",
+                         !thin && albedo >= HighAlbedo);
     if (media > 0 && pixels >= SmallImagePixels && (thin || albedo >= HighAlbedo))
         return byPhotons("at " + size + " the photon map leads the path tracer in " +
                              (thin ? "optically thin media" : "media that scatter light many times (high albedo)"),
@@ -368,10 +388,12 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     usesPhotons_ = photonMapper;
     stats_.integratorUsed = photonMapper ? (combined ? "combined" : "photonMap") : "pathTracer";
     // The measured choice (renderPass): combined with the automatic share measures its photons against
-    // the path tracer, unless a delta light reaches translucent objects only as photons, the photon count
-    // is the settings' (then its noise is not measured either), or the render is too short for it.
+    // the path tracer, unless a delta light reaches translucent objects only as photons, a point or spot
+    // light lights the media (pointLitMedia), the photon count is the settings' (then its noise is not
+    // measured either), or the render is too short for it.
     if (photonMapper && combined && settings_.combinedPhotonShare < 0 && !(choice && choice->photonsOnly) &&
-        settings_.photonsPerPass == 0 && (settings_.progressive() || settings_.samplesPerPixel >= MinTrialRenderPasses))
+        !pointLitMedia(*scene_) && settings_.photonsPerPass == 0 &&
+        (settings_.progressive() || settings_.samplesPerPixel >= MinTrialRenderPasses))
         trial_ = Trial::Photons;
     photonCache_ = photonCache;
     integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache), openMediaSegments) : makePathTracer(*scene_, settings_);

@@ -237,6 +237,13 @@ struct IntegratorChoice {
 /// combined with openMediaByPhotons: its camera segments there are the photon map's (same estimators,
 /// level with photonMap at equal time) and its paths light surfaces with MIS.
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
+/// A point or spot light (a delta light with a position) in a scene with media. The path tracer's
+/// estimate of light scattered more than once has unbounded variance there: a vertex at distance r
+/// from the light gets 1/r^2 from its shadow ray and vertices fall near the light in proportion to
+/// r^2 dr, so the second moment grows as the integral of dr / r^2 (Kulla and Fajardo 2012 sample
+/// single scattering equiangularly for this; the vertices of longer paths keep it). Two passes'
+/// spread cannot measure an infinite variance, so the measured choice leaves such scenes to photons.
+bool pointLitMedia(const Scene& scene);
 
 using ProgressCallback = std::function<void(int passDone, int passTotal)>;
 using CancelCallback = std::function<bool()>;
