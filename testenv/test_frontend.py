@@ -821,6 +821,45 @@ def test_integrator_combined_renders_through_the_cli(tmp_path):
     assert "multiple scattering (photons)" in st["render"]["passes_run"]
 
 
+def test_the_measured_choice_through_the_cli(tmp_path):
+    """--integrator combined at 16 passes with the automatic photon count: passes 1-2 use the photons
+    inside the translucent cube, 3-4 the path tracer, and the cheaper renders the rest (core
+    Renderer::decideTrial); the stats carry both costs and the reason says what was kept. Short renders
+    and explicit photon counts are not measured (choose_integrator: at 16 passes auto tries the photons
+    on the open cube too, at 1 pass its size rule keeps the path tracer)."""
+    stage, path = stage_from(tmp_path, MEDIUM_CUBE % "1.3")
+    stats = tmp_path / "s.json"
+    r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "16",
+                "--integrator", "combined")
+    assert r.returncode == 0, r.stderr
+    st = json.loads(stats.read_text())["frames"][0]["render"]
+    photons, paths = st["measured_photon_cost"], st["measured_path_tracer_cost"]
+    assert photons > 0, st
+    reason = st["integrator_reason"]
+    assert "measured on passes 1-4" in reason, reason
+    if st["integrator_used"] == "pathTracer":
+        assert 0 < paths < photons and reason.endswith("the path tracer renders the rest"), reason
+    else:
+        assert st["integrator_used"] == "combined" and reason.endswith("combined kept"), reason
+        assert paths >= photons or "darker than the photons'" in reason, reason
+    r = run_cli("render", path, "-o", tmp_path / "o.exr", "--stats", stats, "--resolution", "16", "12", "--spp", "16",
+                "--integrator", "combined", "--photons", "2000")
+    assert r.returncode == 0, r.stderr
+    st = json.loads(stats.read_text())["frames"][0]["render"]
+    assert st["measured_photon_cost"] == 0 and st["integrator_used"] == "combined"
+    # What auto tries on an open medium: the photons when the render will measure them, else the size rule.
+    translated = usdscene.translate(stage_from(tmp_path, MEDIUM_CUBE % "1", name="open.usda")[0], Usd.TimeCode.Default(), 16, 12)
+    scene = _core.Scene(translated.desc)
+    settings = _core.RenderSettings()
+    settings.width, settings.height, settings.integrator = 16, 12, _core.RenderSettings.Integrator.Auto
+    for spp, photons_tried in ((1, False), (16, True)):
+        settings.samples_per_pixel = spp
+        choice = _core.choose_integrator(scene, settings)
+        assert choice["open_media_by_photons"] == photons_tried, choice
+        assert choice["integrator"] == ("combined" if photons_tried else "pathTracer"), choice
+        assert ("kept if they measure cheaper" in choice["reason"]) == photons_tried, choice
+
+
 # ------------------------------------------------------------------------------------------------
 # Frames, stats and the command's errors
 # ------------------------------------------------------------------------------------------------

@@ -66,7 +66,11 @@
 // |                     |        |            |              | auto's pilot picks the photon map, camera segments|
 // |                     |        |            |              | in open media are the photon map's (its march's   |
 // |                     |        |            |              | single scattering, its gather with auto's points  |
-// |                     |        |            |              | or beams), else 0 (Renderer)                      |
+// |                     |        |            |              | or beams), else 0 (Renderer); in renders of 16    |
+// |                     |        |            |              | passes and up (or progressive) with photonsPerPass|
+// |                     |        |            |              | 0, passes 1-2 use the photons, 3-4 the path tracer|
+// |                     |        |            |              | and the cheaper renders the rest (the measured    |
+// |                     |        |            |              | choice, Renderer::decideTrial)                    |
 // | photonBeams         | bool   | false      |              | photonMap: multiple scattering from photon beams  |
 // |                     |        |            |              | (beam x beam 1D, short beams: photonBeams.h), not |
 // |                     |        |            |              | photon points, where media are optically thin     |
@@ -375,6 +379,11 @@ private:
     std::unique_ptr<Integrator> trialPathTracer_;  ///< the path tracer of the trial passes
     PhotonNoiseSums trialSpread_;  ///< the trial passes' spread (whole, wholePixels) and difference
     std::vector<float> trialPhotonMean_;  ///< each pixel's mean of its two photon samples (NaN: none)
+    /// The trial's path-traced samples, kept apart: merged into film_ if the path tracer wins, dropped
+    /// (with their passes) if the photons do, so that a photon render's few costly passes are not
+    /// mixed with two samples of a noisier kind.
+    std::unique_ptr<Film> trialFilm_;
+    uint64_t trialSamplesPerPass_ = 0;
     double photonPassSeconds_ = 0;  ///< a photon pass's expected seconds once the count is resized
     std::shared_ptr<PhotonCache> photonCache_;
     int integratorPass_ = 0;  ///< passes integrator_ has begun (its photon passes' index)

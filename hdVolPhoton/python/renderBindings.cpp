@@ -271,6 +271,19 @@ void bindRender(py::module_& m) {
         .def_property_readonly("photons_per_pass", &PhotonCache::photonsPerPass)
         .def("clear", &PhotonCache::clear);
 
+    m.def("choose_integrator", [](std::shared_ptr<Scene> scene, const RenderSettings& settings) {
+        if (!scene) throw py::value_error("choose_integrator: scene is None");
+        IntegratorChoice c = chooseIntegrator(*scene, settings);
+        py::dict d;
+        d["integrator"] = c.integrator == RenderSettings::Integrator::Combined ? "combined" : "pathTracer";
+        d["reason"] = c.reason;
+        d["photons_only"] = c.photonsOnly;
+        d["open_media_by_photons"] = c.openMediaByPhotons;
+        d["photon_beams"] = c.photonBeams;
+        return d;
+    }, py::arg("scene"), py::arg("settings"),
+       "What integrator = auto would render `scene` with at these settings, and why (core chooseIntegrator)");
+
     py::class_<Renderer, std::shared_ptr<Renderer>>(m, "Renderer")
         .def(py::init([](std::shared_ptr<Scene> scene, const RenderSettings& settings, std::shared_ptr<PhotonCache> cache) {
             if (!scene) throw py::value_error("Renderer: scene is None");

@@ -93,7 +93,8 @@ std::vector<SettingInfo> makeTable() {
                               "path's vertex in open media (1 inside translucent objects); the path goes on for the "
                               "rest with probability 1 - share (0: the path tracer's in open media; -1: where auto's pilot "
                               "finds the photon map leading there, its single and multiple scattering in open media, "
-                              "else 0)",
+                              "else 0; in renders of 16 passes and up with automatic photons, passes 1-2 use the photons, "
+                              "3-4 the path tracer, and the cheaper renders the rest)",
                               &RS::combinedPhotonShare));
     t.push_back(boolSetting("photonBeams", "", "Photon beams",
                             "photonMap: multiple scattering from photon beams (beam x beam 1D) instead of photon points where media are "
