@@ -847,8 +847,11 @@ def test_the_measured_choice_through_the_cli(tmp_path):
     assert r.returncode == 0, r.stderr
     st = json.loads(stats.read_text())["frames"][0]["render"]
     assert st["measured_photon_cost"] == 0 and st["integrator_used"] == "combined"
-    # What auto tries on an open medium: the photons when the render will measure them, else the size rule.
-    translated = usdscene.translate(stage_from(tmp_path, MEDIUM_CUBE % "1", name="open.usda")[0], Usd.TimeCode.Default(), 16, 12)
+    # What auto tries on an open medium of albedo 0.97: the photons when the render will measure them,
+    # else the size rule (the path tracer below 128 x 128).
+    bright = (MEDIUM_CUBE % "1").replace("float volphoton:density = 8",
+                                         "float volphoton:density = 8\n    color3f volphoton:albedo = (0.97, 0.97, 0.97)")
+    translated = usdscene.translate(stage_from(tmp_path, bright, name="open.usda")[0], Usd.TimeCode.Default(), 16, 12)
     scene = _core.Scene(translated.desc)
     settings = _core.RenderSettings()
     settings.width, settings.height, settings.integrator = 16, 12, _core.RenderSettings.Integrator.Auto

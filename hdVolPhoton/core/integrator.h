@@ -240,6 +240,10 @@ struct IntegratorChoice {
 /// otherwise (README, "Which integrator"). Where the photon map leads on open media the choice is
 /// combined with openMediaByPhotons: its camera segments there are the photon map's (same estimators,
 /// level with photonMap at equal time) and its paths light surfaces with MIS.
+/// Renders long enough for the measured choice (samplesPerPixel >= MinTrialRenderPasses or progressive,
+/// automatic photon count and share) get the photons on open media wherever they may lead (thin or
+/// albedo >= 0.95 at any size, >= 0.85 from 128 x 128, any from 256 x 256) or a point or spot light
+/// lights them (pointLitMedia), and the Renderer's trial decides (Renderer, "the measured choice").
 IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& settings);
 /// A point or spot light (a delta light with a position) in a scene with media. The path tracer's
 /// estimate of light scattered more than once has unbounded variance there: a vertex at distance r
