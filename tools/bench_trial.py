@@ -2,7 +2,7 @@
 
 For each scene: the truth is each side's cost to a given noise at equal time, measured the long way
 (per-pixel variance of the beauty's channel average over SEEDS renders of PASSES passes, times seconds a
-pass): the path tracer, and `combined` with the photons the trial tries (the automatic share of a
+pass after the first, whose pilots are a render's setup): the path tracer, and `combined` with the photons the trial tries (the automatic share of a
 render too short for a trial: PASSES < 16 passes, with auto's choice of open media forced to the
 photons as the trial's first passes render them). Then the trial itself: `combined` renders of 16
 passes with trial seeds 0..TRIALS-1, stopped after the trial's 4 passes, with the cost ratio it read
@@ -36,13 +36,14 @@ def truth(usd, size, integrator, passes, seeds, threads, overrides):
         core, scene, s, _, _ = ours.build(usd, size[0], size[1], integrator, threads, 100 + seed, None,
                                           dict(overrides, samples_per_pixel=passes))
         r = core.Renderer(scene, s)
+        r.render_pass()  # not timed: pass 1 holds the pilots (photon count, integrator), a render's setup
         t = time.perf_counter()
-        for _ in range(passes):
+        for _ in range(passes - 1):
             r.render_pass()
         seconds += time.perf_counter() - t
         imgs.append(np.array(r.film.beauty, dtype=np.float64).mean(axis=-1))
     variance = np.array(imgs).var(axis=0, ddof=1).mean() * passes  # of one sample
-    return variance, seconds / (seeds * passes)
+    return variance, seconds / (seeds * (passes - 1))
 
 
 def main():
@@ -68,7 +69,7 @@ def main():
         photons = {"samples_per_pixel": a.passes}
         if choice["open_media_by_photons"]:
             photons.update(combined_photon_share=1.0, photon_beams=bool(choice["photon_beams"]))
-        reads = []
+        reads, measured = [], False
         for seed in range(a.trials):
             core, scene, s, _, _ = ours.build(usd, a.size[0], a.size[1], "combined", a.threads, seed, None,
                                               {"samples_per_pixel": 16})
@@ -76,15 +77,21 @@ def main():
             for _ in range(TRIAL_PASSES + 1):
                 r.render_pass()
             st = r.stats
+            measured |= st["measured_photon_cost"] > 0
             if st["measured_photon_cost"] > 0:
                 reads.append("%.2f (%s)" % (st["measured_path_tracer_cost"] / st["measured_photon_cost"],
                                             "PT" if st["integrator_used"] == "pathTracer" else "photons"))
             else:
                 reads.append("not measured (%s)" % st["integrator_used"])
+        if choice["open_media_by_photons"]:
+            tries = "photons in open media (%s)" % ("beams" if choice["photon_beams"] else "points")
+        elif measured:
+            tries = "photons in translucent objects"
+        else:
+            print("| %s | nothing: combined renders as the path tracer | - | %s |" % (name, ", ".join(reads)), flush=True)
+            continue
         pt_var, pt_s = truth(usd, a.size, "pathTracer", a.passes, a.seeds, a.threads, {})
         ph_var, ph_s = truth(usd, a.size, "combined", a.passes, a.seeds, a.threads, photons)
-        tries = ("photons in open media (%s)" % ("beams" if choice["photon_beams"] else "points")
-                 if choice["open_media_by_photons"] else "photons in translucent objects")
         ratio = (pt_var * pt_s) / (ph_var * ph_s) if ph_var * ph_s > 0 else float("inf")
         print("| %s | %s | %.3g (variance %.3g / %.3g, ms a pass %.2f / %.2f) | %s |" % (
             name, tries, ratio, pt_var, ph_var, 1e3 * pt_s, 1e3 * ph_s, ", ".join(reads)), flush=True)

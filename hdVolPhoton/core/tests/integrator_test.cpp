@@ -1504,6 +1504,19 @@ SceneDesc emissiveCloudBesideFog() {
 /// The scenes integrator = combined is checked on: every kind of light the path tracer treats apart
 /// (a distant light: next-event estimation; a sphere light: next-event estimation with MIS; a point
 /// light: equiangular sampling; volume emission: ratio tracking) and surfaces both lit by and lighting the media.
+/// A translucent box [-0.6, 0.6]^3: a dielectric of n = 1.3 (mesh "marble") with a medium of sigma_t 5
+/// and `albedo` inside, added to `d` as its next medium and mesh.
+void addTranslucentBox(SceneDesc& d, const Spectrum& albedo) {
+    auto inside = MediumCoefficients::fromAlbedo(5.0, Spectrum(1.0), albedo, Spectrum(0.0), makeIsotropicPhase());
+    d.media.push_back(std::make_shared<HomogeneousMedium>(inside, Bounds3{Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6)}));
+    MeshDesc box = test::boxMesh("marble", Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6));
+    box.material.kind = SurfaceMaterial::Kind::Dielectric;
+    box.material.ior = 1.3;
+    box.interiorMedium = static_cast<int>(d.media.size()) - 1;
+    d.meshes.push_back(box);
+    d.instances.push_back({static_cast<int>(d.meshes.size()) - 1, Affine()});
+}
+
 std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
     std::vector<std::pair<std::string, SceneDesc>> scenes;
     SceneDesc fog = mediaOnlyScene();
@@ -1519,14 +1532,7 @@ std::vector<std::pair<std::string, SceneDesc>> combinedScenes() {
     // A translucent box (a dielectric of n = 1.3 with a medium inside) in thin fog under a dome: inside
     // it the photons take all multiple scattering whatever the share; outside, the share decides.
     SceneDesc translucent;
-    auto marble = MediumCoefficients::fromAlbedo(5.0, Spectrum(1.0), Spectrum(0.95, 0.9, 0.8), Spectrum(0.0), makeIsotropicPhase());
-    translucent.media.push_back(std::make_shared<HomogeneousMedium>(marble, Bounds3{Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6)}));
-    MeshDesc box = test::boxMesh("marble", Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6));
-    box.material.kind = SurfaceMaterial::Kind::Dielectric;
-    box.material.ior = 1.3;
-    box.interiorMedium = 0;
-    translucent.meshes.push_back(box);
-    translucent.instances.push_back({0, Affine()});
+    addTranslucentBox(translucent, Spectrum(0.95, 0.9, 0.8));
     translucent.media.push_back(std::make_shared<HomogeneousMedium>(
         MediumCoefficients::fromAlbedo(0.3, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase()),
         Bounds3{Vec3(-2, -2, -2), Vec3(2, 2, 2)}));
@@ -1607,17 +1613,10 @@ TEST(IntegratorCombined, TheDefaultShareFollowsAutosPilot) {
 }
 
 namespace {
-/// A translucent box (n = 1.3, a medium of sigma_t 5 and albedo 0.9 inside) alone, lit by `light`.
+/// The translucent box (addTranslucentBox, albedo 0.9 inside) alone, lit by `light`.
 SceneDesc translucentBoxLitBy(LightPtr light) {
     SceneDesc d;
-    auto inside = MediumCoefficients::fromAlbedo(5.0, Spectrum(1.0), Spectrum(0.9), Spectrum(0.0), makeIsotropicPhase());
-    d.media.push_back(std::make_shared<HomogeneousMedium>(inside, Bounds3{Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6)}));
-    MeshDesc box = test::boxMesh("marble", Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6));
-    box.material.kind = SurfaceMaterial::Kind::Dielectric;
-    box.material.ior = 1.3;
-    box.interiorMedium = 0;
-    d.meshes.push_back(box);
-    d.instances.push_back({0, Affine()});
+    addTranslucentBox(d, Spectrum(0.9));
     d.lights.push_back(std::move(light));
     d.camera = lookAt(Vec3(0.3, 0.4, 2.5), Vec3(0, 0, 0), 0.6);
     return d;
