@@ -305,8 +305,7 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // beams where the media scatter light many times (as the rule below for 128 x 128 and up).
     // Point and spot lights are not measured: near one, the path tracer's variance is unbounded
     // (pointLitMedia), so their photons are kept.
-    const bool measured = settings.photonsPerPass == 0 && settings.combinedPhotonShare < 0 &&
-                          (settings.progressive() || settings.samplesPerPixel >= MinTrialRenderPasses);
+    const bool measured = settings.photonsPerPass == 0 && settings.combinedPhotonShare < 0 && longEnoughToMeasure(settings);
     const bool mayLead = thin || albedo >= HighAlbedo || (albedo >= MidAlbedo && pixels >= SmallImagePixels) ||
                          pixels >= LargeImagePixels;
     if (media > 0 && measured && pointLitMedia(scene))
@@ -398,8 +397,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     // light lights the media (pointLitMedia), the photon count is the settings' (then its noise is not
     // measured either), or the render is too short for it.
     if (photonMapper && combined && settings_.combinedPhotonShare < 0 && !(choice && choice->photonsOnly) &&
-        !pointLitMedia(*scene_) && settings_.photonsPerPass == 0 &&
-        (settings_.progressive() || settings_.samplesPerPixel >= MinTrialRenderPasses))
+        !pointLitMedia(*scene_) && settings_.photonsPerPass == 0 && longEnoughToMeasure(settings_))
         trial_ = Trial::Photons;
     photonCache_ = photonCache;
     integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache), openMediaSegments) : makePathTracer(*scene_, settings_);
@@ -517,7 +515,7 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     static_assert(PhotonNoisePasses == 2 && TrialPasses == 2, "the spread of two samples: (x1 - x0)^2 / 2");
     const bool measureNoise = !trialPass && integrator_->measuresPhotonNoise() && photonNoisePasses_ < PhotonNoisePasses;
     // Which of its two samples this pass gives a pixel's spread: the photon measurement's or the trial's.
-    const int spreadSample = measureNoise ? photonNoisePasses_ : trialPass ? pass_ - PhotonNoisePasses : -1;
+    const int spreadSample = measureNoise ? photonNoisePasses_ : trialPass ? trialPassesRun_ : -1;
     if (spreadSample == 0) photonNoiseFirst_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
     if (measureNoise && spreadSample == 0 && trial_ == Trial::Photons)
         trialPhotonMean_.assign(active_.size(), std::numeric_limits<float>::quiet_NaN());
@@ -538,9 +536,11 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                     for (int x = tx * tile; x < std::min(settings_.width, (tx + 1) * tile); ++x) {
                         if (!active_[static_cast<size_t>(y) * settings_.width + x]) continue;
                         const ImagePoint* light = lightPixel(x, y);
+                        if (trialPass && light) continue;  // left out of the measurement, so not rendered
                         for (int k = 0, n = light ? LightPixelSamples : 1; k < n; ++k) {
-                            // The pixel's own sample index (= pass_ unless adaptive sampling skipped it).
-                            uint32_t sample = film_.samples(x, y) + (trialPass ? trialFilm_->samples(x, y) : 0);
+                            // The pixel's own sample index (= pass_ unless adaptive sampling skipped it);
+                            // a trial pass's are the next ones, which the pass after the trial renders again.
+                            uint32_t sample = film_.samples(x, y) + (trialPass ? uint32_t(trialPassesRun_) : 0u);
                             Rng rng(hashKeys(x, y, settings_.seed), sample);
                             rng.stratify(sample, hashKeys(0x51534d43ULL, x, y, settings_.seed), settings_.stratifiedDims);
                             PathRadiance L;
@@ -573,19 +573,21 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                                     }
                                 }
                             }
-                            (trialPass ? *trialFilm_ : film_).add(x, y, L);
+                            if (!trialPass) film_.add(x, y, L);
                         }
                         if (pass_ == 0) film_.setIds(x, y, pixelIds(camera, x, y));
                     }
             }
     });
-    if (!cancelled) {
-        const uint64_t samplesBefore = stats_.cameraSamples;
+    if (!cancelled && trialPass) {
+        ++trialPassesRun_;  // not a pass of the film's: pass_, stats_.passes and the samples stand
+    } else if (!cancelled) {
         stats_.cameraSamples += stats_.activePixels;
         for (const LightPixel& p : lightPixels_) stats_.cameraSamples += active_[p.index] ? LightPixelSamples - 1 : 0;
-        if (trialPass) trialSamplesPerPass_ = stats_.cameraSamples - samplesBefore;
         ++pass_;
         ++stats_.passes;
+    }
+    if (!cancelled) {
         PhotonNoiseSums& spread = measureNoise ? photonNoise_ : trialSpread_;
         for (const PhotonNoiseSums& t : noiseTiles) {
             spread.photon += t.photon;
@@ -606,13 +608,10 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
                 integrator_->photonNoiseMeasured(n.photon / n.photonPixels, n.whole / n.wholePixels, n.wholePixels, stats_);
             if (trial_ == Trial::Photons) {
                 trial_ = n.photonPixels > 0 && n.wholePixels > 0 ? Trial::PathTracer : Trial::Off;
-                if (trial_ == Trial::PathTracer) {
-                    trialPathTracer_ = makePathTracer(*scene_, settings_);
-                    trialFilm_ = std::make_unique<Film>(settings_.width, settings_.height);
-                }
+                if (trial_ == Trial::PathTracer) trialPathTracer_ = makePathTracer(*scene_, settings_);
             }
         }
-        updateAdaptive();  // timed with the pass: the time limit counts it
+        if (!trialPass) updateAdaptive();  // timed with the pass: the time limit counts it
     }
     auto end = std::chrono::steady_clock::now();
     stats_.photonSeconds += std::chrono::duration<double>(photonsDone - start).count();
@@ -621,14 +620,14 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
     lastPassSeconds_ = std::chrono::duration<double>(end - start).count();
     // The next photon pass's photons, where the measurement just raised their count, take that much
     // longer (the pass after the trial's, if the photons win it).
-    if (pass_ == PhotonNoisePasses && !trialPass) {
+    if (pass_ == PhotonNoisePasses && !trialPass && !cancelled) {
         photonPassSeconds_ = lastPassSeconds_;
         if (stats_.photonsPerPassResized > stats_.photonsPerPass && stats_.photonsPerPass > 0)
             photonPassSeconds_ += std::chrono::duration<double>(photonsDone - start).count() *
                                   (double(stats_.photonsPerPassResized) / stats_.photonsPerPass - 1);
         if (trial_ != Trial::PathTracer) lastPassSeconds_ = photonPassSeconds_;
     }
-    if (!cancelled && trialPass && pass_ == PhotonNoisePasses + TrialPasses) decideTrial();
+    if (!cancelled && trialPass && trialPassesRun_ == TrialPasses) decideTrial();
     if (cancelled) {
         stats_.cancelled = true;
         return false;
@@ -654,10 +653,12 @@ bool Renderer::renderPass(const CancelCallback& cancel) {
 // photons' at equal time). Its mean betrays it: the light it missed. So the path tracer is taken only
 // where its trial image's mean is within ShortfallTolerance (the photons' kernel bias) plus 4 standard
 // errors of the photon passes' mean.
-// The trial's path-traced samples go to a film of their own: where the photons win they are dropped
-// with their passes (a photon render has few, costly passes, and two noisier samples among them cost
-// it: the atmosphere at 80 x 60 kept 37 passes in 4 s, and its two path-traced ones raised the RMSE
-// 1.6x); where the path tracer wins they join the photons' two (both estimate the same image).
+// The trial's path-traced samples never reach the film, and its passes are not the film's (pass_,
+// stats.passes and cameraSamples leave them out; their time counts): where the photons win, two
+// noisier samples among a photon render's few, costly passes would cost it (the atmosphere at 80 x 60
+// runs 37 passes in 4 s; with its two path-traced ones in the film its RMSE was 1.6x the photon
+// map's), and where the path tracer wins it renders the same two samples again (the same sample
+// indices). A render stopped during the trial (a time limit) holds the photons' passes alone.
 void Renderer::decideTrial() {
     constexpr double ShortfallTolerance = 0.02;
     const PhotonNoiseSums& n = photonNoise_;
@@ -687,20 +688,12 @@ void Renderer::decideTrial() {
                       100 * shortfall / std::max(photonMean, 1e-300));
     if (!fallsShort && stats_.measuredPathTracerCost < stats_.measuredPhotonCost) {
         if (photonCache_) photonCache_->setMeasuredChoice(PhotonCache::Choice::PathTracer);
-        film_.merge(*trialFilm_);
-        trialFilm_.reset();
         switchToPathTracer(std::move(trialPathTracer_), std::string(text) + ": the path tracer renders the rest");
         return;
     }
-    // The path tracer's passes are dropped: they are not counted, and the photons' next pass takes
-    // up the film's sample indices where their own passes left them.
     if (photonCache_) photonCache_->setMeasuredChoice(PhotonCache::Choice::Photons);
     trial_ = Trial::Done;
     trialPathTracer_.reset();
-    trialFilm_.reset();
-    pass_ -= TrialPasses;
-    stats_.passes -= TrialPasses;
-    stats_.cameraSamples -= uint64_t(TrialPasses) * trialSamplesPerPass_;
     stats_.passesRun.push_back(std::string(text) + ": combined renders the rest");
     stats_.integratorReason += "; " + std::string(text) + ": combined kept";
     lastPassSeconds_ = photonPassSeconds_;

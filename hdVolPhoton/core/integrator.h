@@ -291,6 +291,11 @@ constexpr double CameraShareFloor = 64;
 /// renders the rest; only in renders of at least MinTrialRenderPasses passes (or progressive ones),
 /// where the loser's few samples weigh little.
 constexpr int TrialPasses = 2, MinTrialRenderPasses = 16;
+/// A render with at least MinTrialRenderPasses passes to come (samplesPerPixel; maxSamplesPerPixel
+/// for progressive ones).
+inline bool longEnoughToMeasure(const RenderSettings& s) {
+    return (s.progressive() ? s.maxSamplesPerPixel : s.samplesPerPixel) >= MinTrialRenderPasses;
+}
 constexpr double PhotonShare = 1.0;
 inline int autoPhotonsPerPass(double balance) {
     if (!(balance > 0)) return MinAutoPhotons;
@@ -383,11 +388,7 @@ private:
     std::unique_ptr<Integrator> trialPathTracer_;  ///< the path tracer of the trial passes
     PhotonNoiseSums trialSpread_;  ///< the trial passes' spread (whole, wholePixels) and difference
     std::vector<float> trialPhotonMean_;  ///< each pixel's mean of its two photon samples (NaN: none)
-    /// The trial's path-traced samples, kept apart: merged into film_ if the path tracer wins, dropped
-    /// (with their passes) if the photons do, so that a photon render's few costly passes are not
-    /// mixed with two samples of a noisier kind.
-    std::unique_ptr<Film> trialFilm_;
-    uint64_t trialSamplesPerPass_ = 0;
+    int trialPassesRun_ = 0;  ///< the path tracer's trial passes run (not film passes: decideTrial)
     double photonPassSeconds_ = 0;  ///< a photon pass's expected seconds once the count is resized
     std::shared_ptr<PhotonCache> photonCache_;
     int integratorPass_ = 0;  ///< passes integrator_ has begun (its photon passes' index)
