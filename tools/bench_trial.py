@@ -16,6 +16,7 @@ Prints a Markdown table: path tracer / photons cost ratio (truth; < 1: the path 
 the trial's reads, and what it kept. Run alone on the machine (it times renders).
 """
 import argparse
+import contextlib
 import os
 import sys
 import time
@@ -30,12 +31,24 @@ SCENES = ("homogeneous_cube,vdb_cloud,dense_cloud,fog_spotlight,atmosphere_sunse
 TRIAL_PASSES = 4  # PhotonNoisePasses + TrialPasses (core/integrator.h)
 
 
-def truth(usd, size, integrator, passes, seeds, threads, overrides):
+@contextlib.contextmanager
+def changed(settings, **values):
+    """The scene's settings with `values` set, as they were afterwards (a Renderer copies them)."""
+    before = {k: getattr(settings, k) for k in values}
+    for k, v in values.items():
+        setattr(settings, k, v)
+    try:
+        yield settings
+    finally:
+        for k, v in before.items():
+            setattr(settings, k, v)
+
+
+def truth(core, scene, s, passes, seeds):
     imgs, seconds = [], 0.0
     for seed in range(seeds):
-        core, scene, s, _, _ = ours.build(usd, size[0], size[1], integrator, threads, 100 + seed, None,
-                                          dict(overrides, samples_per_pixel=passes))
-        r = core.Renderer(scene, s)
+        with changed(s, seed=100 + seed, samples_per_pixel=passes):
+            r = core.Renderer(scene, s)
         r.render_pass()  # not timed: pass 1 holds the pilots (photon count, integrator), a render's setup
         t = time.perf_counter()
         for _ in range(passes - 1):
@@ -62,18 +75,17 @@ def main():
     print("|---|---|---|---|")
     for name in a.scenes.split(","):
         usd = os.path.join(root, name + ".usda")
-        # What a trial-length render of combined tries: auto's choice at 16 passes.
+        # The scene translated once; what a trial-length render of combined tries: auto's choice at 16 passes.
         core, scene, s, _, _ = ours.build(usd, a.size[0], a.size[1], "combined", a.threads, 0, None,
                                           {"samples_per_pixel": 16})
         choice = core.choose_integrator(scene, s)
-        photons = {"samples_per_pixel": a.passes}
+        photons = {}
         if choice["open_media_by_photons"]:
-            photons.update(combined_photon_share=1.0, photon_beams=bool(choice["photon_beams"]))
+            photons = dict(combined_photon_share=1.0, photon_beams=bool(choice["photon_beams"]))
         reads, measured = [], False
         for seed in range(a.trials):
-            core, scene, s, _, _ = ours.build(usd, a.size[0], a.size[1], "combined", a.threads, seed, None,
-                                              {"samples_per_pixel": 16})
-            r = core.Renderer(scene, s)
+            with changed(s, seed=seed):
+                r = core.Renderer(scene, s)
             for _ in range(TRIAL_PASSES + 1):
                 r.render_pass()
             st = r.stats
@@ -90,8 +102,10 @@ def main():
         else:
             print("| %s | nothing: combined renders as the path tracer | - | %s |" % (name, ", ".join(reads)), flush=True)
             continue
-        pt_var, pt_s = truth(usd, a.size, "pathTracer", a.passes, a.seeds, a.threads, {})
-        ph_var, ph_s = truth(usd, a.size, "combined", a.passes, a.seeds, a.threads, photons)
+        with changed(s, integrator=core.RenderSettings.Integrator.PathTracer):
+            pt_var, pt_s = truth(core, scene, s, a.passes, a.seeds)
+        with changed(s, **photons):
+            ph_var, ph_s = truth(core, scene, s, a.passes, a.seeds)
         ratio = (pt_var * pt_s) / (ph_var * ph_s) if ph_var * ph_s > 0 else float("inf")
         print("| %s | %s | %.3g (variance %.3g / %.3g, ms a pass %.2f / %.2f) | %s |" % (
             name, tries, ratio, pt_var, ph_var, 1e3 * pt_s, 1e3 * ph_s, ", ".join(reads)), flush=True)

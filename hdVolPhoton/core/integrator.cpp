@@ -305,7 +305,7 @@ IntegratorChoice chooseIntegrator(const Scene& scene, const RenderSettings& sett
     // beams where the media scatter light many times (as the rule below for 128 x 128 and up).
     // Point and spot lights are not measured: near one, the path tracer's variance is unbounded
     // (pointLitMedia), so their photons are kept.
-    const bool measured = settings.photonsPerPass == 0 && settings.combinedPhotonShare < 0 && longEnoughToMeasure(settings);
+    const bool measured = measuresChoice(settings);
     const bool mayLead = thin || albedo >= HighAlbedo || (albedo >= MidAlbedo && pixels >= SmallImagePixels) ||
                          pixels >= LargeImagePixels;
     if (media > 0 && measured && pointLitMedia(scene))
@@ -396,8 +396,7 @@ Renderer::Renderer(std::shared_ptr<const Scene> scene, const RenderSettings& set
     // the path tracer, unless a delta light reaches translucent objects only as photons, a point or spot
     // light lights the media (pointLitMedia), the photon count is the settings' (then its noise is not
     // measured either), or the render is too short for it.
-    if (photonMapper && combined && settings_.combinedPhotonShare < 0 && !(choice && choice->photonsOnly) &&
-        !pointLitMedia(*scene_) && settings_.photonsPerPass == 0 && longEnoughToMeasure(settings_))
+    if (photonMapper && combined && measuresChoice(settings_) && !(choice && choice->photonsOnly) && !pointLitMedia(*scene_))
         trial_ = Trial::Photons;
     photonCache_ = photonCache;
     integrator_ = photonMapper ? makePhotonMapper(*scene_, resolved, std::move(photonCache), openMediaSegments) : makePathTracer(*scene_, settings_);

@@ -291,10 +291,12 @@ constexpr double CameraShareFloor = 64;
 /// renders the rest; only in renders of at least MinTrialRenderPasses passes (or progressive ones),
 /// where the loser's few samples weigh little.
 constexpr int TrialPasses = 2, MinTrialRenderPasses = 16;
-/// A render with at least MinTrialRenderPasses passes to come (samplesPerPixel; maxSamplesPerPixel
-/// for progressive ones).
-inline bool longEnoughToMeasure(const RenderSettings& s) {
-    return (s.progressive() ? s.maxSamplesPerPixel : s.samplesPerPixel) >= MinTrialRenderPasses;
+/// Settings the measured choice applies to: the automatic photon count (whose measurement passes are
+/// the photons' side of the trial) and share, and at least MinTrialRenderPasses passes to come
+/// (samplesPerPixel; maxSamplesPerPixel for progressive renders).
+inline bool measuresChoice(const RenderSettings& s) {
+    return s.photonsPerPass == 0 && s.combinedPhotonShare < 0 &&
+           (s.progressive() ? s.maxSamplesPerPixel : s.samplesPerPixel) >= MinTrialRenderPasses;
 }
 constexpr double PhotonShare = 1.0;
 inline int autoPhotonsPerPass(double balance) {
